@@ -1,0 +1,63 @@
+"""The native ``.geobrep`` format: a lossless container for a whole scene.
+
+Registered through ``geobrep_register_formats`` like any third-party format.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from pydantic import BaseModel, ConfigDict
+
+from geobrep.adapters.native.container import NativeDocument, load, looks_native, save
+from geobrep.hookspecs import hookimpl
+from geobrep.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.scene import Scene
+
+__all__ = ["NativeDocument", "NativeOptions", "geobrep_register_formats", "load", "save"]
+
+
+class NativeOptions(BaseModel):
+    """Options of the native format."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    compress: bool = False
+    """Deflate the arrays (smaller files, slower; the data stay bit-identical)."""
+
+
+def _read(path: Path, options: NativeOptions) -> Scene:
+    return load(path)
+
+
+def _write(scene: Scene, path: Path, options: NativeOptions) -> None:
+    save(scene, path, compress=options.compress)
+
+
+@hookimpl
+def geobrep_register_formats(registry: FormatRegistry) -> None:
+    """Register the ``native`` format (``.geobrep``)."""
+    registry.add(
+        FormatSpec(
+            name="native",
+            description="geobrep's lossless scene container (zip of JSON + .npy arrays)",
+            extensions=(".geobrep",),
+            reader=_read,
+            writer=_write,
+            sniff=looks_native,
+            options=NativeOptions,
+            capabilities=FormatCapabilities(
+                entity_types=frozenset(
+                    {"PointSet", "PolyLine", "Polygon", "Surface", "NurbsSurface",
+                     "Annotation", "Block", "LinearOctree"}
+                ),
+                point_data=True,
+                cell_data=True,
+                names=True,
+                ids=True,
+                topology=True,
+                crs=True,
+                multiple_entities=True,
+            ),
+        )
+    )

@@ -1,0 +1,105 @@
+"""geobrep: a typed B-Rep scene graph for 3D geological structural models.
+
+>>> import geobrep
+>>> scene = geobrep.datasets.faulted_layer_cake()
+>>> len(scene.blocks), scene.blocks[0].kind
+(6, 'unit')
+
+Files are read and written through the format registry (``geobrep.read`` / ``geobrep.write``);
+modelling work is done by plugins (``geobrep.plugins``). Optional heavy libraries (open3d,
+pyvista) are imported only by the features that use them.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+from geobrep.crs import CRS
+from geobrep.entities import (
+    Annotation,
+    Block,
+    Entity,
+    LinearOctree,
+    NurbsSurface,
+    PatchSide,
+    PointSet,
+    Polygon,
+    PolyLine,
+    Surface,
+)
+from geobrep.errors import (
+    DegenerateGeometryError,
+    EntityNotFoundError,
+    EntityValidationError,
+    FileAccessError,
+    FormatError,
+    GeobrepError,
+    MissingDependencyError,
+    OptionsError,
+    PluginError,
+    TopologyError,
+    UnknownFormatError,
+)
+from geobrep.geometry import BoundingBox, Plane
+from geobrep.io import read, write
+from geobrep.properties import Property
+from geobrep.scene import Group, Scene
+from geobrep.topology import Arc, Corner, Patch, Topology
+
+if TYPE_CHECKING:
+    from geobrep import datasets, plugins
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "CRS",
+    "Annotation",
+    "Arc",
+    "Block",
+    "BoundingBox",
+    "Corner",
+    "DegenerateGeometryError",
+    "Entity",
+    "EntityNotFoundError",
+    "EntityValidationError",
+    "FileAccessError",
+    "FormatError",
+    "GeobrepError",
+    "Group",
+    "LinearOctree",
+    "MissingDependencyError",
+    "NurbsSurface",
+    "OptionsError",
+    "Patch",
+    "PatchSide",
+    "Plane",
+    "PluginError",
+    "PointSet",
+    "PolyLine",
+    "Polygon",
+    "Property",
+    "Scene",
+    "Surface",
+    "Topology",
+    "TopologyError",
+    "UnknownFormatError",
+    "__version__",
+    "datasets",
+    "plugins",
+    "read",
+    "write",
+]
+
+_LAZY_SUBMODULES = {"plugins", "datasets"}
+
+
+def __getattr__(name: str) -> Any:
+    """Import ``geobrep.plugins`` and ``geobrep.datasets`` on first use (keeps import fast)."""
+    if name in _LAZY_SUBMODULES:
+        return importlib.import_module(f"geobrep.{name}")
+    raise AttributeError(f"module 'geobrep' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | _LAZY_SUBMODULES)

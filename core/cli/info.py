@@ -1,0 +1,144 @@
+"""``geobrep info FILE``: what a file holds — entities, counts, bounds, CRS, properties."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from geobrep.entities import Block, Entity, LinearOctree, NurbsSurface, Polygon, PolyLine, Surface
+from geobrep.io import read
+from geobrep.properties import PropertyMap
+from geobrep.scene import Scene
+
+__all__ = ["add_parser", "describe_entity", "describe_scene"]
+
+
+def add_parser(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "info", help="describe a file", description="Describe the entities of a file."
+    )
+    parser.add_argument("file", help="file to describe (any readable format)")
+    parser.add_argument("--format", help="format name, when the extension is not enough")
+    parser.add_argument("--json", action="store_true", help="print JSON for machines")
+    parser.set_defaults(run=run)
+
+
+def _properties(props: PropertyMap) -> list[dict[str, Any]]:
+    return [
+        {
+            "name": name,
+            "dtype": str(prop.dtype),
+            "element_size": prop.element_size,
+            "unit": prop.unit,
+            "no_data_value": prop.no_data_value,
+        }
+        for name, prop in props.items()
+    ]
+
+
+def _counts(entity: Entity) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    if hasattr(entity, "vertices"):
+        counts["vertices"] = int(entity.vertices.shape[0])
+    if isinstance(entity, Surface):
+        counts["faces"] = entity.n_faces
+        counts["patches"] = entity.n_patches
+    elif isinstance(entity, PolyLine):
+        counts["parts"] = entity.n_parts
+        counts["segments"] = entity.n_cells
+    elif isinstance(entity, Polygon):
+        counts["polygons"] = entity.n_polygons
+        counts["rings"] = entity.n_rings
+    elif isinstance(entity, NurbsSurface):
+        counts["control_points"] = entity.n_points
+    elif isinstance(entity, LinearOctree):
+        counts["leaves"] = entity.n_leaves
+    elif isinstance(entity, Block):
+        counts["sides"] = len(entity.sides)
+    return counts
+
+
+def describe_entity(entity: Entity) -> dict[str, Any]:
+    """A JSON-ready summary of one entity."""
+    bounds = entity.bounds
+    return {
+        "id": entity.id,
+        "type": type(entity).__name__,
+        "name": entity.name,
+        "kind": entity.kind,
+        "counts": _counts(entity),
+        "bounds": list(bounds.as_tuple()) if bounds is not None else None,
+        "point_data": _properties(entity.point_data),
+        "cell_data": _properties(entity.cell_data),
+    }
+
+
+def describe_scene(scene: Scene) -> dict[str, Any]:
+    """A JSON-ready summary of a scene."""
+    bounds = scene.bounds
+    return {
+        "name": scene.name,
+        "crs": scene.crs.model_dump(mode="json") if scene.crs else None,
+        "bounds": list(bounds.as_tuple()) if bounds is not None else None,
+        "entities": [describe_entity(e) for e in scene.entities],
+        "topology": {
+            "corners": len(scene.topology.corners),
+            "arcs": len(scene.topology.arcs),
+            "patches": len(scene.topology.patches),
+            "blocks": len(scene.blocks),
+            "universe": scene.universe is not None,
+        },
+        "groups": [g.name for g in scene.groups],
+    }
+
+
+def _format_bounds(bounds: list[float] | None) -> str:
+    if bounds is None:
+        return "-"
+    xmin, xmax, ymin, ymax, zmin, zmax = bounds
+    return f"x [{xmin:.3f}, {xmax:.3f}]  y [{ymin:.3f}, {ymax:.3f}]  z [{zmin:.3f}, {zmax:.3f}]"
+
+
+def render_text(summary: dict[str, Any], source: str) -> str:
+    """Human-readable form of :func:`describe_scene`."""
+    crs = summary["crs"]
+    crs_text = "none"
+    if crs:
+        label = f"EPSG:{crs['epsg']}" if crs.get("epsg") else (crs.get("name") or "unnamed")
+        crs_text = (
+            f"{label} (axes {' '.join(crs['axis_names'])}, units {' '.join(crs['axis_units'])}, "
+            f"z positive {crs['z_positive']} in the source)"
+        )
+    lines = [
+        f"{source}: {len(summary['entities'])} entities",
+        f"  CRS     {crs_text}",
+        f"  bounds  {_format_bounds(summary['bounds'])}",
+    ]
+    topo = summary["topology"]
+    if topo["patches"] or topo["blocks"]:
+        lines.append(
+            f"  topology  {topo['corners']} corners, {topo['arcs']} arcs, "
+            f"{topo['patches']} patches, {topo['blocks']} blocks"
+            + (" + universe" if topo["universe"] else "")
+        )
+    for entity in summary["entities"]:
+        counts = ", ".join(f"{v} {k}" for k, v in entity["counts"].items())
+        kind = f" [{entity['kind']}]" if entity["kind"] else ""
+        lines.append(f"  #{entity['id']} {entity['type']} {entity['name']!r}{kind}: {counts}")
+        for where in ("point_data", "cell_data"):
+            for prop in entity[where]:
+                unit = f" {prop['unit']}" if prop["unit"] else ""
+                size = f"×{prop['element_size']}" if prop["element_size"] > 1 else ""
+                lines.append(f"      {where} {prop['name']!r}: {prop['dtype']}{size}{unit}")
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    scene = read(args.file, format=args.format)
+    summary = describe_scene(scene)
+    if args.json:
+        print(json.dumps({"file": args.file, **summary}, indent=2))
+    else:
+        print(render_text(summary, args.file))
+    return 0

@@ -1,0 +1,77 @@
+"""The base of geobrep's immutable pydantic models: frozen, strict about extra fields, and
+compared structurally (arrays by dtype, shape and bits, so two models holding NaN no-data values
+in the same places are equal)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict
+
+__all__ = ["FrozenModel", "arrays_identical", "structurally_equal"]
+
+
+def arrays_identical(a: Any, b: Any) -> bool:
+    """Same dtype, same shape, same bits."""
+    if not (isinstance(a, np.ndarray) and isinstance(b, np.ndarray)):
+        return False
+    if a.dtype != b.dtype or a.shape != b.shape:
+        return False
+    bits_a = np.ascontiguousarray(a).reshape(-1).view(np.uint8)
+    bits_b = np.ascontiguousarray(b).reshape(-1).view(np.uint8)
+    return bool(np.array_equal(bits_a, bits_b))
+
+
+def structurally_equal(a: Any, b: Any) -> bool:
+    """Deep equality that understands numpy arrays inside models, dicts and sequences."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return arrays_identical(a, b)
+    if isinstance(a, BaseModel) or isinstance(b, BaseModel):
+        return type(a) is type(b) and all(
+            structurally_equal(getattr(a, n), getattr(b, n)) for n in type(a).model_fields
+        )
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(structurally_equal(a[k], b[k]) for k in a)
+    if isinstance(a, tuple | list) and isinstance(b, tuple | list):
+        return len(a) == len(b) and all(
+            structurally_equal(x, y) for x, y in zip(a, b, strict=True)
+        )
+    return bool(a == b)
+
+
+class FrozenModel(BaseModel):
+    """Immutable model with structural equality (unhashable: it may hold arrays)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        return structurally_equal(self, other)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr_args__(self) -> Any:
+        for name, value in super().__repr_args__():
+            if isinstance(value, np.ndarray):
+                yield name, _ArraySummary(value)
+            elif isinstance(value, tuple) and len(value) > 6:
+                yield name, _ArraySummary(value)
+            elif name in ("point_data", "cell_data", "metadata") and not value:
+                continue
+            else:
+                yield name, value
+
+
+class _ArraySummary:
+    """Stands for a bulky value in a repr."""
+
+    def __init__(self, value: Any) -> None:
+        if isinstance(value, np.ndarray):
+            self.text = f"<array {value.dtype} {value.shape}>"
+        else:
+            self.text = f"<{len(value)} {type(value[0]).__name__} items>"
+
+    def __repr__(self) -> str:
+        return self.text

@@ -1,0 +1,1 @@
+"""JSON Schemas generated from geobrep's pydantic models."""
