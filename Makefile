@@ -1,0 +1,78 @@
+# geobrep — two commands on a fresh machine:
+#   make demo   set up .venv and run the demo job on the built-in sample model
+#   make test   set up .venv and run ruff, mypy and the whole test suite
+# Both are quick on a second run (installs are skipped until pyproject.toml changes).
+
+PYTHON ?= python3
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+STAMPS := $(VENV)/.geobrep-stamps
+EXAMPLE_PLUGIN := docs/examples/geobrep-example-plugin
+PIP_QUIET := --quiet --disable-pip-version-check
+
+.PHONY: demo test lint typecheck pytest bench schemas sysdeps clean help
+
+help:
+	@echo "make demo   - run the demo on the built-in sample model (writes demo-output/)"
+	@echo "make test   - ruff + mypy + the whole test suite"
+	@echo "make bench  - benchmarks (not part of make test)"
+
+$(PY):
+	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "geobrep needs Python 3.11 or newer: set PYTHON=python3.11 (or newer)")'
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install $(PIP_QUIET) --upgrade "pip>=23.1" "setuptools>=69" wheel
+
+$(STAMPS)/base: pyproject.toml | $(PY)
+	$(PY) -m pip install $(PIP_QUIET) -e .
+	@mkdir -p $(STAMPS) && touch $@
+
+$(STAMPS)/test: pyproject.toml $(STAMPS)/base
+	$(PY) -m pip install $(PIP_QUIET) -e ".[test,dev,open3d]"
+	@mkdir -p $(STAMPS) && touch $@
+
+# open3d (the `open3d` extra) needs system libraries that a bare machine may lack.
+sysdeps:
+	@if ! ldconfig -p 2>/dev/null | grep -q 'libusb-1.0.so.0'; then \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    echo "installing libusb-1.0-0 (needed by open3d)"; \
+	    apt-get install -y -qq libusb-1.0-0 >/dev/null 2>&1 || \
+	      { apt-get update -qq >/dev/null && apt-get install -y -qq libusb-1.0-0 >/dev/null; } || \
+	      echo "could not install libusb-1.0-0: open3d features will be unavailable"; \
+	  else \
+	    echo "open3d needs libusb-1.0, which is missing. Install it with:"; \
+	    echo "    sudo apt-get install libusb-1.0-0    # Debian/Ubuntu"; \
+	    echo "    sudo dnf install libusb1             # Fedora/RHEL"; \
+	    echo "(everything else works without it)"; \
+	  fi; \
+	fi
+
+demo: $(STAMPS)/base
+	$(VENV)/bin/geobrep demo --output demo-output
+
+lint: $(STAMPS)/test
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
+
+# mypy cannot follow setuptools' editable finder for the core/ -> geobrep mapping, so it checks a
+# tree of symbolic links laid out as the installed package.
+typecheck: $(STAMPS)/test
+	@rm -rf build/typecheck && mkdir -p build/typecheck/geobrep
+	@for entry in core/*; do ln -s "$(CURDIR)/$$entry" build/typecheck/geobrep/; done
+	@ln -s "$(CURDIR)/plugins" build/typecheck/geobrep/plugins
+	@ln -s "$(CURDIR)/adapters" build/typecheck/geobrep/adapters
+	@ln -s "$(CURDIR)/schemas" build/typecheck/geobrep/schemas
+	cd build/typecheck && MYPYPATH=. $(CURDIR)/$(VENV)/bin/mypy --config-file $(CURDIR)/pyproject.toml -p geobrep
+
+pytest: $(STAMPS)/test sysdeps
+	$(PY) -m pytest
+
+test: lint typecheck pytest
+
+schemas: $(STAMPS)/base
+	$(PY) -m geobrep.schemas
+
+bench: $(STAMPS)/test
+	$(PY) benchmarks/run_all.py
+
+clean:
+	rm -rf build dist *.egg-info .mypy_cache .ruff_cache .pytest_cache demo-output

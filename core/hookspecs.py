@@ -1,0 +1,93 @@
+"""The geobrep plugin hooks (pluggy project name ``"geobrep"``).
+
+Every hook receives one registry and adds items to it. A plugin implements any subset of
+the hooks with the :data:`hookimpl` marker::
+
+    from geobrep.plugins import FormatSpec, hookimpl
+
+    @hookimpl
+    def geobrep_register_formats(registry):
+        registry.add(FormatSpec(name="xyz", extensions=(".xyz",), reader=read_xyz))
+
+Compatibility promise: hook specs only grow. A hook may gain new optional arguments, never
+lose or rename one, so an implementation written today keeps working (pluggy passes an
+implementation only the arguments it names). This module must stay cheap to import: it
+needs pluggy only, the registry types are for annotations.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import pluggy
+
+if TYPE_CHECKING:
+    from geobrep.registry import BuilderRegistry, ClipperRegistry, FitterRegistry, FormatRegistry
+
+__all__ = ["PROJECT_NAME", "GeobrepSpecs", "hookimpl", "hookspec"]
+
+PROJECT_NAME = "geobrep"
+
+hookspec = pluggy.HookspecMarker(PROJECT_NAME)
+"""Marks a hook specification (geobrep's own use)."""
+
+hookimpl = pluggy.HookimplMarker(PROJECT_NAME)
+"""Marks a plugin's hook implementation: ``@hookimpl def geobrep_register_formats(registry)``."""
+
+
+class GeobrepSpecs:
+    """The hook specifications; plugins implement them as plain functions or methods."""
+
+    @hookspec
+    def geobrep_register_formats(self, registry: FormatRegistry) -> None:
+        """Register file formats: one :class:`~geobrep.registry.FormatSpec` per format.
+
+        Example::
+
+            @hookimpl
+            def geobrep_register_formats(registry):
+                registry.add(FormatSpec(
+                    name="xyz", extensions=(".xyz",), reader=read_xyz, writer=write_xyz,
+                    sniff=looks_like_xyz, options=XyzOptions,
+                    capabilities=FormatCapabilities(entity_types=frozenset({"PointSet"})),
+                ))
+        """
+
+    @hookspec
+    def geobrep_register_clippers(self, registry: ClipperRegistry) -> None:
+        """Register plane clippers: one :class:`~geobrep.registry.ClipperSpec` per entity type.
+
+        Example::
+
+            @hookimpl
+            def geobrep_register_clippers(registry):
+                registry.add(ClipperSpec(
+                    name="pointset", entity_type="PointSet", function=clip_pointset,
+                ))
+        """
+
+    @hookspec
+    def geobrep_register_fitters(self, registry: FitterRegistry) -> None:
+        """Register surface or curve fitters: :class:`~geobrep.registry.FitterSpec` items.
+
+        Example::
+
+            @hookimpl
+            def geobrep_register_fitters(registry):
+                registry.add(FitterSpec(
+                    name="plane", function=fit_plane, input_types=("PointSet",),
+                ))
+        """
+
+    @hookspec
+    def geobrep_register_builders(self, registry: BuilderRegistry) -> None:
+        """Register topology or block builders: :class:`~geobrep.registry.BuilderSpec` items.
+
+        Example::
+
+            @hookimpl
+            def geobrep_register_builders(registry):
+                registry.add(BuilderSpec(
+                    name="blocks", function=build_blocks, input_types=("Surface",),
+                ))
+        """

@@ -1,0 +1,12 @@
+"""A plugin that registers a good fitter, then an item with an invalid name."""
+
+from __future__ import annotations
+
+from geobrep.plugins import FitterSpec, hookimpl
+from geobrep.registry import FitterRegistry
+
+
+@hookimpl
+def geobrep_register_fitters(registry: FitterRegistry) -> None:
+    registry.add(FitterSpec(name="partial", function=print))
+    registry.add(FitterSpec(name="Not A Valid Name", function=print))

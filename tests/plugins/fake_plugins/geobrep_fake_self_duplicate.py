@@ -1,0 +1,12 @@
+"""A plugin that registers the same name twice."""
+
+from __future__ import annotations
+
+from geobrep.plugins import BuilderSpec, hookimpl
+from geobrep.registry import BuilderRegistry
+
+
+@hookimpl
+def geobrep_register_builders(registry: BuilderRegistry) -> None:
+    registry.add(BuilderSpec(name="twice", function=print))
+    registry.add(BuilderSpec(name="twice", function=print))
