@@ -16,7 +16,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
-from typing import Annotated, Any, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,11 +27,14 @@ __all__ = [
     "ARRAY_READER",
     "ARRAY_WRITER",
     "BoolArray",
+    "ControlNet",
+    "FaceArray",
     "FloatArray",
     "IndexArray",
     "NumericArray",
     "Points",
     "Vector3",
+    "WeightGrid",
     "array_field",
     "array_reader",
     "as_readonly",
@@ -59,6 +62,7 @@ def array_reader(reader: Callable[[str], NDArray[Any]]) -> Iterator[None]:
         yield
     finally:
         _ACTIVE_READER.reset(token)
+
 
 _ARRAY_JSON_SCHEMA: dict[str, Any] = {
     "type": "object",
@@ -229,9 +233,23 @@ def array_field(
     ]
 
 
-Points = array_field("float64", (None, 3), finite=True)
-Vector3 = array_field("float64", (3,), finite=True)
-FloatArray = array_field("float64", (None,), finite=True)
-IndexArray = array_field("integer", (None,))
-BoolArray = array_field("bool", (None,))
-NumericArray = array_field("numeric")
+if TYPE_CHECKING:  # what type checkers see: plain numpy arrays
+    Points: TypeAlias = NDArray[np.float64]
+    Vector3: TypeAlias = NDArray[np.float64]
+    FloatArray: TypeAlias = NDArray[np.float64]
+    IndexArray: TypeAlias = NDArray[np.integer[Any]]
+    BoolArray: TypeAlias = NDArray[np.bool_]
+    NumericArray: TypeAlias = NDArray[Any]
+    FaceArray: TypeAlias = NDArray[np.integer[Any]]
+    ControlNet: TypeAlias = NDArray[np.float64]
+    WeightGrid: TypeAlias = NDArray[np.float64]
+else:
+    Points = array_field("float64", (None, 3), finite=True)
+    Vector3 = array_field("float64", (3,), finite=True)
+    FloatArray = array_field("float64", (None,), finite=True)
+    IndexArray = array_field("integer", (None,))
+    BoolArray = array_field("bool", (None,))
+    NumericArray = array_field("numeric")
+    FaceArray = array_field("integer", (None, None), columns=(3, 4))
+    ControlNet = array_field("float64", (None, None, 3), finite=True)
+    WeightGrid = array_field("float64", (None, None), finite=True)

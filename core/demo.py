@@ -52,14 +52,20 @@ def _model_stage(ctx: DemoContext) -> None:
 
 def _blocks_stage(ctx: DemoContext) -> None:
     scene = ctx.scene
-    rows = []
+    rows: list[dict[str, Any]] = []
     for block in scene.blocks:
         boundary = scene.block_mesh(block)
-        rows.append({
-            "id": block.id, "name": block.name, "unit": block.unit_name,
-            "volume_m3": boundary.volume, "closed": boundary.is_closed,
-            "oriented": boundary.is_consistently_oriented, "triangles": boundary.n_faces,
-        })
+        rows.append(
+            {
+                "id": block.id,
+                "name": block.name,
+                "unit": block.unit_name,
+                "volume_m3": boundary.volume,
+                "closed": boundary.is_closed,
+                "oriented": boundary.is_consistently_oriented,
+                "triangles": boundary.n_faces,
+            }
+        )
         ctx.lines.append(
             f"  block #{block.id} {block.name!r:24} volume {boundary.volume:14.1f} m³  "
             f"closed={boundary.is_closed} oriented={boundary.is_consistently_oriented}"
@@ -69,8 +75,11 @@ def _blocks_stage(ctx: DemoContext) -> None:
     total = sum(r["volume_m3"] for r in rows)
     ctx.summary["blocks"] = rows
     ctx.summary["adjacency"] = scene.block_adjacency()
-    ctx.summary["volume_check"] = {"sum_of_blocks": total, "model_shell": shell,
-                                   "relative_difference": abs(total - shell) / shell}
+    ctx.summary["volume_check"] = {
+        "sum_of_blocks": total,
+        "model_shell": shell,
+        "relative_difference": abs(total - shell) / shell,
+    }
     ctx.lines.append(
         f"  sum of block volumes {total:.1f} m³ vs model shell {shell:.1f} m³ "
         f"(relative difference {abs(total - shell) / shell:.1e})"
@@ -88,9 +97,13 @@ def _native_stage(ctx: DemoContext) -> None:
     identical = again == ctx.scene
     points = datasets.scattered_points()
     write(points, ctx.output / "survey_points.geobrep")
-    ctx.summary["native"] = {"file": str(path), "bytes": path.stat().st_size,
-                             "write_s": written - start, "read_s": loaded - written,
-                             "round_trip_identical": identical}
+    ctx.summary["native"] = {
+        "file": str(path),
+        "bytes": path.stat().st_size,
+        "write_s": written - start,
+        "read_s": loaded - written,
+        "round_trip_identical": identical,
+    }
     ctx.lines.append(
         f"native: wrote {path} ({path.stat().st_size / 1e6:.2f} MB) in {written - start:.3f} s, "
         f"read back in {loaded - written:.3f} s, identical={identical}"

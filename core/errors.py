@@ -8,7 +8,7 @@ builtin exception a caller would naturally catch, so ``except ValueError`` keeps
     ├── TopologyError (ValueError)            corners/arcs/patches/blocks do not fit together
     ├── DegenerateGeometryError (ValueError)  zero normal, zero-area plane, ...
     ├── OptionsError (ValueError)             bad options for a plugin item
-    ├── FormatError (ValueError)              a file cannot be parsed or written; carries path and line
+    ├── FormatError (ValueError)              a file cannot be parsed or written (path, line)
     │   └── UnknownFormatError                no registered format matches
     ├── EntityNotFoundError (KeyError)        no entity with that id or name
     ├── FileAccessError (OSError)             missing or unreadable file
@@ -116,6 +116,5 @@ class MissingDependencyError(GeobrepError, ImportError):
         self.package = package
         self.extra = extra
         super().__init__(
-            f"{feature} needs the optional package '{package}': "
-            f"pip install 'geobrep[{extra}]'"
+            f"{feature} needs the optional package '{package}': pip install 'geobrep[{extra}]'"
         )

@@ -34,9 +34,7 @@ def structurally_equal(a: Any, b: Any) -> bool:
     if isinstance(a, dict) and isinstance(b, dict):
         return a.keys() == b.keys() and all(structurally_equal(a[k], b[k]) for k in a)
     if isinstance(a, tuple | list) and isinstance(b, tuple | list):
-        return len(a) == len(b) and all(
-            structurally_equal(x, y) for x, y in zip(a, b, strict=True)
-        )
+        return len(a) == len(b) and all(structurally_equal(x, y) for x, y in zip(a, b, strict=True))
     return bool(a == b)
 
 
@@ -54,9 +52,7 @@ class FrozenModel(BaseModel):
 
     def __repr_args__(self) -> Any:
         for name, value in super().__repr_args__():
-            if isinstance(value, np.ndarray):
-                yield name, _ArraySummary(value)
-            elif isinstance(value, tuple) and len(value) > 6:
+            if isinstance(value, np.ndarray) or (isinstance(value, tuple) and len(value) > 6):
                 yield name, _ArraySummary(value)
             elif name in ("point_data", "cell_data", "metadata") and not value:
                 continue

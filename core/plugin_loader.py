@@ -28,10 +28,11 @@ from importlib.metadata import EntryPoint, entry_points
 from typing import Any, Literal
 
 import pluggy
+from pydantic import BaseModel, ConfigDict, Field
+
 from geobrep.errors import PluginError
 from geobrep.hookspecs import PROJECT_NAME, GeobrepSpecs
 from geobrep.registry import GeobrepPluginWarning, RegisteredItem, Registries, Registry
-from pydantic import BaseModel, ConfigDict, Field
 
 __all__ = [
     "DISABLE_ENV",

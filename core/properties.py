@@ -24,7 +24,6 @@ from pydantic import Field, GetCoreSchemaHandler, JsonValue, model_validator
 from pydantic_core import core_schema
 
 from geobrep.arrays import NumericArray
-
 from geobrep.model import FrozenModel
 
 __all__ = ["Property", "PropertyMap"]

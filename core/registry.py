@@ -21,7 +21,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, Generic, TypeVar
 
-from geobrep.errors import GeobrepError, OptionsError, PluginError, UnknownFormatError
 from pydantic import (
     AliasChoices,
     BaseModel,
@@ -30,6 +29,8 @@ from pydantic import (
     field_validator,
     model_validator,
 )
+
+from geobrep.errors import GeobrepError, OptionsError, PluginError, UnknownFormatError
 
 __all__ = [
     "SNIFF_BYTES",

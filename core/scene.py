@@ -1,4 +1,4 @@
-"""The scene graph: entities by id and name, a group tree, the CRS, the topology, a spatial index."""
+"""The scene graph: entities by id and name, a group tree, CRS, topology and a spatial index."""
 
 from __future__ import annotations
 
@@ -152,10 +152,10 @@ class Scene(FrozenModel):
         owner: dict[tuple[int, int], int] = {}
         for block in self.of_type(Block):
             for patch_id, side in block.sides:
-                patch = patches.get(patch_id)
-                if patch is None:
+                listed = patches.get(patch_id)
+                if listed is None:
                     raise TopologyError(f"{block.label}: patch {patch_id} does not exist")
-                expected = patch.positive_block if side == 1 else patch.negative_block
+                expected = listed.positive_block if side == 1 else listed.negative_block
                 if expected is not None and expected != block.id:
                     raise TopologyError(
                         f"{block.label}: lists side {side:+d} of patch {patch_id}, "
@@ -201,7 +201,9 @@ class Scene(FrozenModel):
         if not found:
             raise EntityNotFoundError(f"no entity named {key!r}")
         ids = ", ".join(str(e.id) for e in found)
-        raise EntityNotFoundError(f"{len(found)} entities are named {key!r} (ids {ids}): use the id")
+        raise EntityNotFoundError(
+            f"{len(found)} entities are named {key!r} (ids {ids}): use the id"
+        )
 
     def __len__(self) -> int:
         return len(self.entities)
@@ -327,7 +329,11 @@ class Scene(FrozenModel):
             tolerance = RELATIVE_MERGE_TOLERANCE * (self.bounds.diagonal if self.bounds else 1.0)
         merged, inverse = mesh.merge_close_vertices(vertices, tolerance)
         faces = inverse[faces]
-        keep = (faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 0] != faces[:, 2])
+        keep = (
+            (faces[:, 0] != faces[:, 1])
+            & (faces[:, 1] != faces[:, 2])
+            & (faces[:, 0] != faces[:, 2])
+        )
         used, compact = np.unique(faces[keep], return_inverse=True)
         return Surface(
             vertices=merged[used],

@@ -6,11 +6,11 @@ import threading
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
 from geobrep.errors import EntityValidationError
 from geobrep.geometry.bbox import BoundingBox, boxes_plane_side
 from geobrep.geometry.plane import Plane
-from numpy.typing import ArrayLike, NDArray
-from rtree import index as rtree_index
 
 __all__ = ["SpatialIndex"]
 
@@ -93,6 +93,8 @@ class SpatialIndex:
         self._sorted_ids: IntArray = _frozen(sorted_ids)
         self._row_of_sorted: IntArray = _frozen(order.astype(np.int64))
         self._lock = threading.Lock()
+        from rtree import index as rtree_index  # imported on first use: keeps imports fast
+
         properties = rtree_index.Property(dimension=3)
         # rtree's numpy methods are unannotated: hold the index as Any.
         self._index: Any

@@ -48,8 +48,16 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
             options=NativeOptions,
             capabilities=FormatCapabilities(
                 entity_types=frozenset(
-                    {"PointSet", "PolyLine", "Polygon", "Surface", "NurbsSurface",
-                     "Annotation", "Block", "LinearOctree"}
+                    {
+                        "PointSet",
+                        "PolyLine",
+                        "Polygon",
+                        "Surface",
+                        "NurbsSurface",
+                        "Annotation",
+                        "Block",
+                        "LinearOctree",
+                    }
                 ),
                 point_data=True,
                 cell_data=True,

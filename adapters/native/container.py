@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import zipfile
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Final, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,8 +25,8 @@ from geobrep.scene import Scene
 
 __all__ = ["FORMAT_ID", "FORMAT_VERSION", "NativeDocument", "load", "looks_native", "save"]
 
-FORMAT_ID = "geobrep-scene"
-FORMAT_VERSION = 1
+FORMAT_ID: Final = "geobrep-scene"
+FORMAT_VERSION: Final = 1
 SCENE_MEMBER = "scene.json"
 _ZIP_MAGIC = b"PK\x03\x04"
 
@@ -64,9 +64,7 @@ def _write_container(scene: Scene, path: Path, compress: bool) -> None:
         arrays.append((name, array))
         return name
 
-    document = NativeDocument(scene=scene).model_dump(
-        mode="json", context={ARRAY_WRITER: store}
-    )
+    document = NativeDocument(scene=scene).model_dump(mode="json", context={ARRAY_WRITER: store})
     method = zipfile.ZIP_DEFLATED if compress else zipfile.ZIP_STORED
     with zipfile.ZipFile(path, "w", compression=method, allowZip64=True) as archive:
         archive.writestr(SCENE_MEMBER, json.dumps(document, indent=1, allow_nan=False))

@@ -13,6 +13,7 @@ block builder and a test bed for clipping and voxelization.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import defaultdict
 from dataclasses import dataclass, field
@@ -46,12 +47,17 @@ class _Section:
         return len(self.points) - 1
 
     def polyline(self, surface: str, chain: list[int]) -> None:
-        self.edges.extend((surface, a, b) for a, b in zip(chain, chain[1:], strict=False))
+        self.edges.extend((surface, a, b) for a, b in itertools.pairwise(chain))
 
 
 def _section(
-    width: float, height: float, horizons: list[float], dip: float, fault_top: float,
-    fault_slope: float, throw: float,
+    width: float,
+    height: float,
+    horizons: list[float],
+    dip: float,
+    fault_top: float,
+    fault_slope: float,
+    throw: float,
 ) -> _Section:
     section = _Section()
     top_left, top_right = section.point(0, 0), section.point(width, 0)
@@ -109,8 +115,9 @@ def _cells(section: _Section) -> list[list[tuple[int, int]]]:
                 _, a, b = section.edges[current[0]]
                 head = b if current[1] == 1 else a
                 spokes = outgoing[head]
-                back = next(i for i, s in enumerate(spokes) if s[1] == current[0] and
-                            (s[2] == -current[1]))
+                back = next(
+                    i for i, s in enumerate(spokes) if s[1] == current[0] and (s[2] == -current[1])
+                )
                 _, next_edge, next_dir = spokes[(back - 1) % len(spokes)]  # turn most right
                 current = (next_edge, next_dir)
             area = 0.0
@@ -176,7 +183,7 @@ def faulted_layer_cake(
         out[:, 2] += (
             fold_amplitude * np.sin(np.pi * xyz[:, 0] / width) * np.sin(np.pi * xyz[:, 1] / length)
         )
-        return out + np.asarray(origin)
+        return np.asarray(out + np.asarray(origin), dtype=np.float64)
 
     # -- surfaces: one patch per section edge (strips) or per cell (south/north faces) --------
     strip_surfaces: dict[str, list[int]] = defaultdict(list)  # surface -> its edges, in order
@@ -199,7 +206,7 @@ def faulted_layer_cake(
             vertex_parts.append(grid.reshape(-1, 3))
             face_parts.append(np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]]))
         builders[surface] = (vertex_parts, face_parts)
-    for surface, at_y, flip in (("south", 0.0, False), ("north", length, True)):
+    for face_name, at_y, flip in (("south", 0.0, False), ("north", length, True)):
         vertex_parts, face_parts = [], []
         for cycle in cells:
             ring = np.concatenate(
@@ -207,13 +214,15 @@ def faulted_layer_cake(
             )
             centre = ring.mean(axis=0)
             k = len(ring)
-            fan = np.stack([np.zeros(k, np.int64), np.arange(1, k + 1),
-                            np.roll(np.arange(k), -1) + 1], axis=1)
-            xyz = np.column_stack([np.r_[centre[0], ring[:, 0]], np.full(k + 1, at_y),
-                                   np.r_[centre[1], ring[:, 1]]])
+            fan = np.stack(
+                [np.zeros(k, np.int64), np.arange(1, k + 1), np.roll(np.arange(k), -1) + 1], axis=1
+            )
+            xyz = np.column_stack(
+                [np.r_[centre[0], ring[:, 0]], np.full(k + 1, at_y), np.r_[centre[1], ring[:, 1]]]
+            )
             vertex_parts.append(xyz)
             face_parts.append(fan[:, ::-1] if flip else fan)
-        builders[surface] = (vertex_parts, face_parts)
+        builders[face_name] = (vertex_parts, face_parts)
 
     kinds = {"fault": "fault", **{f"H{i}": "horizon" for i in range(1, n_horizons + 1)}}
     entities: list[Surface] = []
@@ -231,8 +240,12 @@ def faulted_layer_cake(
             names = tuple(f"{surface}:cell{k}" for k in range(len(cells)))
         entities.append(
             Surface(
-                id=surface_id, name=surface, kind=kinds.get(surface, "boundary"),
-                vertices=fold(merged), faces=inverse[faces], patch_labels=labels,
+                id=surface_id,
+                name=surface,
+                kind=kinds.get(surface, "boundary"),
+                vertices=fold(merged),
+                faces=inverse[faces],
+                patch_labels=labels,
                 patch_names=names,
             )
         )
@@ -244,8 +257,18 @@ def faulted_layer_cake(
         shift = throw if hanging else 0.0
         layer = 1 + sum(1 for level in levels if level - shift + dip * cx > cz)
         cell_names.append(("hanging wall" if hanging else "footwall", layer))
-    return _with_topology(entities, section, cells, patch_of_edge, edge_points, ys, fold,
-                          origin, n_horizons, cell_names)
+    return _with_topology(
+        entities,
+        section,
+        cells,
+        patch_of_edge,
+        edge_points,
+        ys,
+        fold,
+        origin,
+        n_horizons,
+        cell_names,
+    )
 
 
 def _with_topology(
@@ -284,14 +307,14 @@ def _with_topology(
         for edge, direction in cycle:
             edge_cells[edge].append((cell, direction))
             assign(patch_ids[patch_of_edge[edge]], direction, block_ids[cell])
-        for surface in ("south", "north"):
-            assign(patch_ids[(int(by_name[surface].id or 0), cell)], -1, block_ids[cell])
+        for face_name in ("south", "north"):
+            assign(patch_ids[(int(by_name[face_name].id or 0), cell)], -1, block_ids[cell])
     for edge in range(len(section.edges)):
         if len(edge_cells[edge]) == 1:
             assign(patch_ids[patch_of_edge[edge]], -edge_cells[edge][0][1], universe_id)
-    for surface in ("south", "north"):
+    for face_name in ("south", "north"):
         for cell in range(len(cells)):
-            assign(patch_ids[(int(by_name[surface].id or 0), cell)], 1, universe_id)
+            assign(patch_ids[(int(by_name[face_name].id or 0), cell)], 1, universe_id)
 
     # Corners at both ends of every section vertex's y-line; arcs along y and along edges.
     n_points = len(section.points)
@@ -303,13 +326,24 @@ def _with_topology(
     arcs: list[Arc] = []
     patch_arcs: dict[int, list[int]] = defaultdict(list)
 
-    def add_arc(points: NDArray[np.float64], start: int, end: int,
-                members: list[tuple[int, NDArray[np.float64]]]) -> None:
+    def add_arc(
+        points: NDArray[np.float64],
+        start: int,
+        end: int,
+        members: list[tuple[int, NDArray[np.float64]]],
+    ) -> None:
         axis = points[-1] - points[0]
         order = mesh.sort_around_axis(points[0], axis, np.array([d for _, d in members]))
         arc_id = len(arcs)
-        arcs.append(Arc(id=arc_id, points=fold(points), start=start, end=end,
-                        patches=tuple(members[i][0] for i in order)))
+        arcs.append(
+            Arc(
+                id=arc_id,
+                points=fold(points),
+                start=start,
+                end=end,
+                patches=tuple(members[i][0] for i in order),
+            )
+        )
         for patch, _ in members:
             patch_arcs[patch].append(arc_id)
 
@@ -319,43 +353,72 @@ def _with_topology(
             if v in (a, b):
                 other = b if v == a else a
                 direction = pts[other] - pts[v]
-                members.append((patch_ids[patch_of_edge[edge]],
-                                np.array([direction[0], 0.0, direction[1]])))
+                members.append(
+                    (patch_ids[patch_of_edge[edge]], np.array([direction[0], 0.0, direction[1]]))
+                )
         line = np.column_stack([np.full(len(ys), pts[v][0]), ys, np.full(len(ys), pts[v][1])])
         add_arc(line, v, n_points + v, members)
     for edge, (_, a, b) in enumerate(section.edges):
         dx, dz = pts[b] - pts[a]
         left = np.array([-dz, 0.0, dx])
-        for k, (y, surface, inward) in enumerate(((ys[0], "south", 1.0), (ys[-1], "north", -1.0))):
+        for k, (y, face_name, inward) in enumerate(
+            ((ys[0], "south", 1.0), (ys[-1], "north", -1.0))
+        ):
             members = [(patch_ids[patch_of_edge[edge]], np.array([0.0, inward, 0.0]))]
             for cell, direction in edge_cells[edge]:
-                members.append((patch_ids[(int(by_name[surface].id or 0), cell)],
-                                left * direction))
+                members.append(
+                    (patch_ids[(int(by_name[face_name].id or 0), cell)], left * direction)
+                )
             line = edge_points[edge]
             points = np.column_stack([line[:, 0], np.full(len(line), y), line[:, 1]])
             add_arc(points, k * n_points + a, k * n_points + b, members)
 
     patches = [
-        Patch(id=pid, surface=sid, label=label,
-              name=by_name_label(surfaces, sid, label),
-              positive_block=positive.get(pid), negative_block=negative.get(pid),
-              arcs=tuple(patch_arcs[pid]))
+        Patch(
+            id=pid,
+            surface=sid,
+            label=label,
+            name=by_name_label(surfaces, sid, label),
+            positive_block=positive.get(pid),
+            negative_block=negative.get(pid),
+            arcs=tuple(patch_arcs[pid]),
+        )
         for (sid, label), pid in patch_ids.items()
     ]
     blocks = [
-        Block(id=block_id, name=f"{side} unit {layer}", unit_name=f"unit {layer}",
-              sides=tuple(block_sides[block_id]), metadata={"fault_side": side, "layer": layer})
+        Block(
+            id=block_id,
+            name=f"{side} unit {layer}",
+            unit_name=f"unit {layer}",
+            sides=tuple(block_sides[block_id]),
+            metadata={"fault_side": side, "layer": layer},
+        )
         for block_id, (side, layer) in zip(block_ids, cell_names, strict=True)
     ]
-    blocks.append(Block(id=universe_id, name="universe", kind=UNIVERSE_KIND,
-                        sides=tuple(block_sides[universe_id])))
+    blocks.append(
+        Block(
+            id=universe_id,
+            name="universe",
+            kind=UNIVERSE_KIND,
+            sides=tuple(block_sides[universe_id]),
+        )
+    )
     groups = (
-        Group(name="horizons", kind="horizons",
-              members=tuple(int(s.id or 0) for s in surfaces if s.kind == "horizon")),
-        Group(name="faults", kind="faults",
-              members=tuple(int(s.id or 0) for s in surfaces if s.kind == "fault")),
-        Group(name="boundaries", kind="boundaries",
-              members=tuple(int(s.id or 0) for s in surfaces if s.kind == "boundary")),
+        Group(
+            name="horizons",
+            kind="horizons",
+            members=tuple(int(s.id or 0) for s in surfaces if s.kind == "horizon"),
+        ),
+        Group(
+            name="faults",
+            kind="faults",
+            members=tuple(int(s.id or 0) for s in surfaces if s.kind == "fault"),
+        ),
+        Group(
+            name="boundaries",
+            kind="boundaries",
+            members=tuple(int(s.id or 0) for s in surfaces if s.kind == "boundary"),
+        ),
         Group(name="blocks", kind="blocks", members=tuple(b.id or 0 for b in blocks)),
     )
     return Scene(
@@ -364,8 +427,11 @@ def _with_topology(
         groups=groups,
         crs=CRS(epsg=32631, name="WGS 84 / UTM zone 31N"),
         topology=Topology(corners=tuple(corners), arcs=tuple(arcs), patches=tuple(patches)),
-        metadata={"dataset": "faulted_layer_cake", "n_horizons": n_horizons,
-                  "origin": list(origin)},
+        metadata={
+            "dataset": "faulted_layer_cake",
+            "n_horizons": n_horizons,
+            "origin": list(origin),
+        },
     )
 
 

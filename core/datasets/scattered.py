@@ -68,10 +68,15 @@ def scattered_points(
         name="survey points",
         kind="horizon",
         point_data={
-            "core": Property(values=np.r_[np.ones(len(core), np.int8), np.zeros(len(rim), np.int8)],
-                             description="1 for the dense exact core, 0 for the sparse rim"),
-            "true_z": Property(values=true_z + origin[2], unit="m",
-                               description="noise-free elevation of the sampled surface"),
+            "core": Property(
+                values=np.r_[np.ones(len(core), np.int8), np.zeros(len(rim), np.int8)],
+                description="1 for the dense exact core, 0 for the sparse rim",
+            ),
+            "true_z": Property(
+                values=true_z + origin[2],
+                unit="m",
+                description="noise-free elevation of the sampled surface",
+            ),
         },
         metadata={"crs": CRS(epsg=32631).label, "noise_m": noise, "seed": seed},
     )

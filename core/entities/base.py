@@ -130,7 +130,7 @@ class VertexEntity(Entity):
         return 0 if vertices is None else int(vertices.shape[0])
 
     @cached_property
-    def bounds(self) -> BoundingBox | None:  # type: ignore[override]
+    def bounds(self) -> BoundingBox | None:
         vertices = getattr(self, "vertices", None)
         if vertices is None or len(vertices) == 0:
             return None

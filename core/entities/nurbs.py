@@ -8,15 +8,11 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from geobrep.arrays import array_field
+from geobrep.arrays import ControlNet, FloatArray, WeightGrid
 from geobrep.entities.base import Entity
 from geobrep.geometry.bbox import BoundingBox
 
 __all__ = ["NurbsSurface"]
-
-ControlNet = array_field("float64", (None, None, 3), finite=True)
-Weights = array_field("float64", (None, None), finite=True)
-Knots = array_field("float64", (None,), finite=True)
 
 
 class NurbsSurface(Entity):
@@ -37,10 +33,10 @@ class NurbsSurface(Entity):
     type: Literal["NurbsSurface"] = "NurbsSurface"
     degree_u: int = Field(ge=1)
     degree_v: int = Field(ge=1)
-    knots_u: Knots
-    knots_v: Knots
+    knots_u: FloatArray
+    knots_v: FloatArray
     control_points: ControlNet
-    weights: Weights
+    weights: WeightGrid
 
     @model_validator(mode="before")
     @classmethod
@@ -63,10 +59,12 @@ class NurbsSurface(Entity):
 
     @property
     def is_rational(self) -> bool:
-        return not bool(np.all(self.weights == self.weights.flat[0])) if self.weights.size else False
+        return (
+            not bool(np.all(self.weights == self.weights.flat[0])) if self.weights.size else False
+        )
 
     @cached_property
-    def bounds(self) -> BoundingBox | None:  # type: ignore[override]
+    def bounds(self) -> BoundingBox | None:
         """Box of the control net (it contains the surface: convex-hull property)."""
         if self.control_points.size == 0:
             return None
@@ -79,7 +77,9 @@ class NurbsSurface(Entity):
             ("v", self.degree_v, nv, self.knots_v),
         ):
             if count < degree + 1:
-                raise self.fail("control_points", f"{count} rows along {axis} need degree ≤ {count - 1}")
+                raise self.fail(
+                    "control_points", f"{count} rows along {axis} need degree ≤ {count - 1}"
+                )
             if knots.shape[0] != count + degree + 1:
                 raise self.fail(
                     f"knots_{axis}",
@@ -91,7 +91,9 @@ class NurbsSurface(Entity):
             if knots[degree] >= knots[count]:
                 raise self.fail(f"knots_{axis}", "the parameter domain is empty")
         if self.weights.shape != (nu, nv):
-            raise self.fail("weights", f"shape {self.weights.shape} does not match the net ({nu}, {nv})")
+            raise self.fail(
+                "weights", f"shape {self.weights.shape} does not match the net ({nu}, {nv})"
+            )
         if self.weights.size and self.weights.min() <= 0:
             raise self.fail("weights", "must be positive")
         if self.cell_data:

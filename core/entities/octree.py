@@ -105,7 +105,9 @@ class LinearOctree(Entity):
         if levels.dtype != np.uint8 or levels.shape != codes.shape:
             raise self.fail("levels", f"must be uint8 with one level per code ({codes.shape[0]})")
         if self.labels is not None and self.labels.shape != codes.shape:
-            raise self.fail("labels", f"has {self.labels.shape[0]} labels for {codes.shape[0]} leaves")
+            raise self.fail(
+                "labels", f"has {self.labels.shape[0]} labels for {codes.shape[0]} leaves"
+            )
         if not codes.size:
             return
         if int(levels.max()) > self.depth:
@@ -113,9 +115,13 @@ class LinearOctree(Entity):
         span = np.left_shift(np.uint64(1), (3 * (self.depth - levels.astype(np.uint64))))
         if np.any(codes % span):
             bad = int(np.argmax(codes % span != 0))
-            raise self.fail("codes", f"leaf {bad} code is not aligned to its level {int(levels[bad])}")
+            raise self.fail(
+                "codes", f"leaf {bad} code is not aligned to its level {int(levels[bad])}"
+            )
         if self.depth < MAX_OCTREE_DEPTH and int(codes[-1]) >= 8**self.depth:
-            raise self.fail("codes", f"code {int(codes[-1])} lies outside an octree of depth {self.depth}")
+            raise self.fail(
+                "codes", f"code {int(codes[-1])} lies outside an octree of depth {self.depth}"
+            )
         if np.any(codes[1:] <= codes[:-1]):
             raise self.fail("codes", "must be strictly ascending (Morton order)")
         if np.any(codes[:-1] + span[:-1] > codes[1:]):

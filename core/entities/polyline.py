@@ -65,9 +65,7 @@ class PolyLine(VertexEntity):
             else np.zeros(0, np.int64)
         )
         flags = np.broadcast_to(np.asarray(closed, dtype=bool), lengths.shape).copy()
-        return cls(
-            vertices=vertices, indices=indices, part_offsets=offsets, closed=flags, **fields
-        )
+        return cls(vertices=vertices, indices=indices, part_offsets=offsets, closed=flags, **fields)
 
     @classmethod
     def from_point_lists(
@@ -77,7 +75,9 @@ class PolyLine(VertexEntity):
         arrays = [np.asarray(p, dtype=np.float64).reshape(-1, 3) for p in parts]
         vertices = np.concatenate(arrays) if arrays else np.zeros((0, 3))
         starts = np.cumsum([0] + [len(a) for a in arrays])
-        index_lists = [list(range(int(s), int(s) + len(a))) for s, a in zip(starts, arrays)]
+        index_lists = [
+            list(range(int(s), int(s) + len(a))) for s, a in zip(starts, arrays, strict=False)
+        ]
         return cls.from_parts(vertices, index_lists, closed, **fields)
 
     @property
@@ -122,7 +122,9 @@ class PolyLine(VertexEntity):
     def length(self) -> float:
         """Total length of all segments."""
         seg = self.segments
-        return float(np.linalg.norm(self.vertices[seg[:, 1]] - self.vertices[seg[:, 0]], axis=1).sum())
+        return float(
+            np.linalg.norm(self.vertices[seg[:, 1]] - self.vertices[seg[:, 0]], axis=1).sum()
+        )
 
     def _check(self) -> None:
         n = self.vertices.shape[0]
@@ -136,9 +138,13 @@ class PolyLine(VertexEntity):
             bad = int(np.argmax(lengths < 2))
             raise self.fail("part_offsets", f"part {bad} has {int(lengths[bad])} vertex; need ≥ 2")
         if self.closed.shape[0] != lengths.shape[0]:
-            raise self.fail("closed", f"has {self.closed.shape[0]} flags for {lengths.shape[0]} parts")
+            raise self.fail(
+                "closed", f"has {self.closed.shape[0]} flags for {lengths.shape[0]} parts"
+            )
         short_closed = self.closed & (lengths < 3)
         if short_closed.any():
-            raise self.fail("closed", f"closed part {int(np.argmax(short_closed))} has < 3 vertices")
+            raise self.fail(
+                "closed", f"closed part {int(np.argmax(short_closed))} has < 3 vertices"
+            )
         if self.indices.size and (self.indices.min() < 0 or self.indices.max() >= n):
             raise self.fail("indices", f"refer to vertices outside 0..{n - 1}")

@@ -9,17 +9,15 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
 
-from geobrep.arrays import IndexArray, Points, array_field
+from geobrep.arrays import FaceArray, IndexArray, Points
 from geobrep.entities.base import VertexEntity
 from geobrep.geometry import mesh
 
-__all__ = ["Faces", "Surface"]
-
-Faces = array_field("integer", (None, None), columns=(3, 4))
+__all__ = ["Surface"]
 
 
 class Surface(VertexEntity):
-    """A surface mesh: ``vertices (N, 3)`` float64 and ``faces (M, 3)`` triangles or ``(M, 4)`` quads.
+    """A surface mesh: ``vertices (N, 3)`` float64, ``faces (M, 3)`` triangles or ``(M, 4)`` quads.
 
     Faces may be grouped into named patches (GOCAD TFACE parts, the patches of a B-Rep):
     ``patch_labels[i]`` is the patch of face ``i`` and ``patch_names[label]`` its name. Without
@@ -35,7 +33,7 @@ class Surface(VertexEntity):
     type: Literal["Surface"] = "Surface"
     cell_noun = "faces"
     vertices: Points
-    faces: Faces
+    faces: FaceArray
     patch_labels: IndexArray | None = None
     patch_names: tuple[str, ...] = Field(default=())
 
@@ -132,7 +130,9 @@ class Surface(VertexEntity):
             lo, hi = int(faces.min()), int(faces.max())
             if lo < 0:
                 row = int(np.argmax((faces < 0).any(axis=1)))
-                raise self.fail("faces", f"face {row} has a negative vertex index ({lo} is the smallest)")
+                raise self.fail(
+                    "faces", f"face {row} has a negative vertex index ({lo} is the smallest)"
+                )
             if hi >= n:
                 row = int(np.argmax((faces >= n).any(axis=1)))
                 raise self.fail(

@@ -6,9 +6,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
 from geobrep.errors import DegenerateGeometryError, EntityValidationError
 from geobrep.geometry.plane import Plane, _as_float_array, _as_points, _check_tolerance
-from numpy.typing import ArrayLike, NDArray
 
 __all__ = ["BoundingBox", "boxes_plane_side"]
 

@@ -9,12 +9,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
 from geobrep.errors import DegenerateGeometryError, EntityValidationError
 from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
-from numpy.typing import ArrayLike, NDArray
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
 __all__ = [
     "boundary_edges",
@@ -414,6 +412,10 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
         labels = labels.reshape(-1)
     else:
         centre = 0.5 * (verts.min(axis=0) + verts.max(axis=0))
+        from scipy.sparse import coo_matrix  # imported here: keeps `import geobrep` fast
+        from scipy.sparse.csgraph import connected_components
+        from scipy.spatial import cKDTree
+
         pairs = cKDTree(verts - centre).query_pairs(r=tol, output_type="ndarray")
         graph = coo_matrix(
             (np.ones(pairs.shape[0], dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n)

@@ -6,8 +6,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from geobrep.errors import DegenerateGeometryError, EntityValidationError
 from numpy.typing import ArrayLike, NDArray
+
+from geobrep.errors import DegenerateGeometryError, EntityValidationError
 
 __all__ = ["Plane"]
 

@@ -10,6 +10,7 @@ from importlib.metadata import EntryPoint
 from pathlib import Path
 
 import pytest
+
 from geobrep import plugin_loader
 from geobrep.plugin_loader import DISABLE_ENV, ENTRY_POINT_GROUP, STRICT_ENV
 

@@ -6,9 +6,10 @@ import importlib
 import sys
 from pathlib import Path
 
-import geobrep.plugins
 import numpy as np
 import pytest
+
+import geobrep.plugins
 from geobrep.errors import FormatError, OptionsError
 from geobrep.plugin_loader import DISABLE_ENV
 from geobrep.registry import FormatSpec

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+
 from geobrep.hookspecs import GeobrepSpecs
 from geobrep.plugin_loader import HOOK_KINDS
 

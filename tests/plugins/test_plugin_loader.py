@@ -10,8 +10,9 @@ from collections.abc import Callable
 from importlib.metadata import EntryPoint
 from pathlib import Path
 
-import geobrep.plugins
 import pytest
+
+import geobrep.plugins
 from geobrep import plugin_loader
 from geobrep.errors import PluginError
 from geobrep.hookspecs import GeobrepSpecs

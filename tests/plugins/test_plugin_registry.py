@@ -6,6 +6,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from pydantic import BaseModel, ConfigDict, ValidationError
+
 from geobrep.errors import GeobrepError, OptionsError, PluginError, UnknownFormatError
 from geobrep.registry import (
     SNIFF_BYTES,
@@ -21,7 +23,6 @@ from geobrep.registry import (
     Registries,
     UnknownItemError,
 )
-from pydantic import BaseModel, ConfigDict, ValidationError
 
 
 def read(path: Path, options: Any) -> None:

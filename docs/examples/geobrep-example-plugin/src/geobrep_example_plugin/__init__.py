@@ -11,7 +11,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from geobrep.plugins import FormatCapabilities, FormatSpec, hookimpl
-
 from geobrep_example_plugin.xyz import XyzOptions, looks_like_xyz, read_xyz, write_xyz
 
 if TYPE_CHECKING:

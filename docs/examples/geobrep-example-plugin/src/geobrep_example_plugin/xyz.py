@@ -14,8 +14,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from geobrep.errors import FileAccessError, FormatError
 from pydantic import BaseModel, ConfigDict, Field
+
+from geobrep.errors import FileAccessError, FormatError
 
 if TYPE_CHECKING:
     from geobrep import Scene
