@@ -45,22 +45,32 @@ def main() -> None:
     imports = []
     for _ in range(5):
         out = subprocess.run(
-            [sys.executable, "-c", "import time; t=time.perf_counter(); import geobrep; "
-             "print(time.perf_counter()-t)"],
-            capture_output=True, text=True, check=True,
+            [
+                sys.executable,
+                "-c",
+                "import time; t=time.perf_counter(); import geobrep; print(time.perf_counter()-t)",
+            ],
+            capture_output=True,
+            text=True,
+            check=True,
         )
         imports.append(float(out.stdout))
-    print(f"import geobrep: best {min(imports) * 1e3:.0f} ms, median "
-          f"{statistics.median(imports) * 1e3:.0f} ms (target < 500 ms)")
+    print(
+        f"import geobrep: best {min(imports) * 1e3:.0f} ms, median "
+        f"{statistics.median(imports) * 1e3:.0f} ms (target < 500 ms)"
+    )
 
     import geobrep
 
     vertices, faces = grid_surface_arrays(1_000_000)
     props = {"z2": vertices[:, 2] * 2}
-    build = best_of(lambda: geobrep.Surface(vertices=vertices, faces=faces, point_data=props,
-                                            name="grid"))
-    print(f"Surface of {len(faces):,} triangles ({len(vertices):,} vertices): validation "
-          f"{build * 1e3:.2f} ms (target < 10 ms)")
+    build = best_of(
+        lambda: geobrep.Surface(vertices=vertices, faces=faces, point_data=props, name="grid")
+    )
+    print(
+        f"Surface of {len(faces):,} triangles ({len(vertices):,} vertices): validation "
+        f"{build * 1e3:.2f} ms (target < 10 ms)"
+    )
 
     surface = geobrep.Surface(vertices=vertices, faces=faces, point_data=props, name="grid")
     scene = geobrep.Scene(entities=[surface])
@@ -86,10 +96,12 @@ def main() -> None:
         and again.faces.tobytes() == faces.tobytes()
         and again.point_data["z2"].values.tobytes() == props["z2"].tobytes()
     )
-    print(f"native save+load of 1M triangles: {native * 1e3:.0f} ms (target < 1000 ms); "
-          f"np.savez+np.load of the same arrays: {anchor * 1e3:.0f} ms; "
-          f"ratio {native / anchor:.2f}; bit-identical: {identical}; "
-          f"file {path.stat().st_size / 1e6:.1f} MB")
+    print(
+        f"native save+load of 1M triangles: {native * 1e3:.0f} ms (target < 1000 ms); "
+        f"np.savez+np.load of the same arrays: {anchor * 1e3:.0f} ms; "
+        f"ratio {native / anchor:.2f}; bit-identical: {identical}; "
+        f"file {path.stat().st_size / 1e6:.1f} MB"
+    )
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""The wheel: every package folder is listed, schemas ship, test data do not, and it works installed."""
+"""The wheel: every package folder is declared, schemas ship, test data do not, it works."""
 
 from __future__ import annotations
 
@@ -28,7 +28,8 @@ def test_every_package_folder_is_declared() -> None:
             relative = init.parent.relative_to(ROOT / folder)
             found.add(".".join([name, *relative.parts]))
     # a mapped name's own sub-folders that are separately mapped count once
-    assert found == set(packages), f"pyproject packages out of date: {sorted(found ^ set(packages))}"
+    missing = sorted(found ^ set(packages))
+    assert found == set(packages), f"pyproject packages out of date: {missing}"
 
 
 @pytest.fixture(scope="module")
@@ -42,9 +43,21 @@ def wheel(tmp_path_factory: pytest.TempPathFactory) -> Path:
             shutil.copy(path, source / item)
     out = tmp_path_factory.mktemp("wheel")
     subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q",
-         "-w", str(out), str(source)],
-        check=True, capture_output=True, text=True,
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "wheel",
+            "--no-deps",
+            "--no-build-isolation",
+            "-q",
+            "-w",
+            str(out),
+            str(source),
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
     )
     return next(out.glob("geobrep-*.whl"))
 
@@ -58,26 +71,38 @@ def test_wheel_contents(wheel: Path) -> None:
     assert not [n for n in names if n.startswith("tests/") or "/data/" in n]
     entry_points = next(n for n in names if n.endswith("entry_points.txt"))
     text = zipfile.ZipFile(wheel).read(entry_points).decode()
-    assert "[geobrep.plugins]" in text and "native = geobrep.adapters.native" in text
+    assert "[geobrep.plugins]" in text
+    assert "native = geobrep.adapters.native" in text
     assert "geobrep = geobrep.cli:main" in text
 
 
 def test_installed_wheel_works(wheel: Path, tmp_path: Path) -> None:
     target = tmp_path / "site"
     subprocess.run(
-        [sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(target),
-         str(wheel)],
-        check=True, capture_output=True, text=True,
+        [
+            sys.executable,
+            "-m",
+            "pip",
+            "install",
+            "--no-deps",
+            "-q",
+            "--target",
+            str(target),
+            str(wheel),
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
     )
     script = (
         "import geobrep, json, pathlib, tempfile\n"
-        "assert pathlib.Path(geobrep.__file__).parent.parent == pathlib.Path(%r)\n"
+        "assert pathlib.Path(geobrep.__file__).parent.parent == pathlib.Path(TARGET)\n"
         "scene = geobrep.datasets.faulted_layer_cake()\n"
         "path = pathlib.Path(tempfile.mkdtemp()) / 'cake.geobrep'\n"
         "geobrep.write(scene, path)\n"
         "assert geobrep.read(path) == scene\n"
         "print(json.dumps([p.name for p in geobrep.plugins.list_plugins()]))\n"
-    ) % str(target)
+    ).replace("TARGET", repr(str(target)))
     env = {**os.environ, "PYTHONPATH": str(target)}
     result = subprocess.run(
         [sys.executable, "-c", script], cwd=tmp_path, env=env, capture_output=True, text=True
