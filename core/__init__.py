@@ -27,6 +27,7 @@ from geobrep.entities import (
     Polygon,
     PolyLine,
     Surface,
+    TetMesh,
 )
 from geobrep.errors import (
     DegenerateGeometryError,
@@ -81,6 +82,7 @@ __all__ = [
     "Property",
     "Scene",
     "Surface",
+    "TetMesh",
     "Topology",
     "TopologyError",
     "UnknownFormatError",

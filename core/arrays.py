@@ -33,6 +33,7 @@ __all__ = [
     "IndexArray",
     "NumericArray",
     "Points",
+    "TetArray",
     "Vector3",
     "WeightGrid",
     "array_field",
@@ -122,13 +123,15 @@ def _coerce_dtype(array: NDArray[Any], rule: DTypeRule) -> NDArray[Any]:
     if rule == "float64":
         if array.dtype == np.float64:
             return array
-        if kind in "fiub":
+        if kind in "fiu":  # booleans are not coordinates: reject them like strings
             return array.astype(np.float64)
         raise ValueError(f"expected real numbers, got dtype {array.dtype}")
     if rule == "integer":
         if kind in "iu":
             if array.dtype in (np.int32, np.int64):
                 return array
+            if array.dtype == np.uint64 and array.size and array.max() > np.iinfo(np.int64).max:
+                raise ValueError(f"value {int(array.max())} does not fit a signed 64-bit index")
             return array.astype(np.int64)
         if kind == "f" and array.size == 0:
             return array.astype(np.int64)
@@ -241,6 +244,7 @@ if TYPE_CHECKING:  # what type checkers see: plain numpy arrays
     BoolArray: TypeAlias = NDArray[np.bool_]
     NumericArray: TypeAlias = NDArray[Any]
     FaceArray: TypeAlias = NDArray[np.integer[Any]]
+    TetArray: TypeAlias = NDArray[np.integer[Any]]
     ControlNet: TypeAlias = NDArray[np.float64]
     WeightGrid: TypeAlias = NDArray[np.float64]
 else:
@@ -251,5 +255,6 @@ else:
     BoolArray = array_field("bool", (None,))
     NumericArray = array_field("numeric")
     FaceArray = array_field("integer", (None, None), columns=(3, 4))
+    TetArray = array_field("integer", (None, 4))
     ControlNet = array_field("float64", (None, None, 3), finite=True)
     WeightGrid = array_field("float64", (None, None), finite=True)

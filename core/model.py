@@ -4,7 +4,9 @@ in the same places are equal)."""
 
 from __future__ import annotations
 
-from typing import Any
+import math
+from collections.abc import Mapping
+from typing import Any, Self
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict
@@ -35,6 +37,8 @@ def structurally_equal(a: Any, b: Any) -> bool:
         return a.keys() == b.keys() and all(structurally_equal(a[k], b[k]) for k in a)
     if isinstance(a, tuple | list) and isinstance(b, tuple | list):
         return len(a) == len(b) and all(structurally_equal(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True  # a NaN no-data value equals itself, as NaN array entries do
     return bool(a == b)
 
 
@@ -49,6 +53,17 @@ class FrozenModel(BaseModel):
         return structurally_equal(self, other)
 
     __hash__ = None  # type: ignore[assignment]
+
+    def model_copy(self, *, update: Mapping[str, Any] | None = None, deep: bool = False) -> Self:
+        """A copy; with ``update`` the changed model is validated again (never a stale cache).
+
+        Prefer ``replace(**changes)`` where a model offers it.
+        """
+        if not update:
+            return super().model_copy(deep=deep)
+        values = {name: getattr(self, name) for name in type(self).model_fields}
+        values.update(update)
+        return type(self)(**values)
 
     def __repr_args__(self) -> Any:
         for name, value in super().__repr_args__():

@@ -15,12 +15,14 @@ arrays (``np.asarray(prop)``, ``prop[3]``, ``len(prop)``)::
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Mapping
-from typing import Any, NoReturn
+from typing import Annotated, Any, NoReturn
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field, GetCoreSchemaHandler, JsonValue, model_validator
+from pydantic import Field, GetCoreSchemaHandler, JsonValue, PlainSerializer, model_validator
+from pydantic.json_schema import WithJsonSchema
 from pydantic_core import core_schema
 
 from geobrep.arrays import NumericArray
@@ -29,12 +31,35 @@ from geobrep.model import FrozenModel
 __all__ = ["Property", "PropertyMap"]
 
 
+def _json_float(value: float | None) -> float | str | None:
+    """JSON has no NaN or infinity: write them as the strings pydantic reads back as floats."""
+    if value is None or math.isfinite(value):
+        return value
+    return "NaN" if math.isnan(value) else ("Infinity" if value > 0 else "-Infinity")
+
+
+#: A float (NaN and ±inf allowed: common no-data values) that survives a JSON round trip.
+NoDataValue = Annotated[
+    float | None,
+    PlainSerializer(_json_float, return_type=float | str | None, when_used="json"),
+    WithJsonSchema(
+        {
+            "anyOf": [
+                {"type": "number"},
+                {"enum": ["NaN", "Infinity", "-Infinity"]},
+                {"type": "null"},
+            ]
+        }
+    ),
+]
+
+
 class Property(FrozenModel):
     """A named array's values (``(N,)`` or ``(N, k)`` for vector properties) and their meaning."""
 
     values: NumericArray
     unit: str | None = None
-    no_data_value: float | None = None
+    no_data_value: NoDataValue = None
     description: str = ""
     metadata: dict[str, JsonValue] = Field(default_factory=dict)
 

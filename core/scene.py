@@ -23,6 +23,7 @@ from geobrep.entities import (
     Polygon,
     PolyLine,
     Surface,
+    TetMesh,
 )
 from geobrep.errors import (
     EntityNotFoundError,
@@ -236,6 +237,10 @@ class Scene(FrozenModel):
         return self.of_type(Polygon)
 
     @property
+    def tet_meshes(self) -> tuple[TetMesh, ...]:
+        return self.of_type(TetMesh)
+
+    @property
     def nurbs_surfaces(self) -> tuple[NurbsSurface, ...]:
         return self.of_type(NurbsSurface)
 
@@ -320,7 +325,9 @@ class Scene(FrozenModel):
             triangles = triangles.astype(np.int64) + offsets[patch.surface]
             pieces.append(mesh.flip_faces(triangles) if side == 1 else triangles)
             labels.append(np.full(len(triangles), position, dtype=np.int64))
-            names.append(patch.name or f"{surface.name or surface.label}:{patch.label}")
+            names.append(
+                patch.name or f"{surface.name or surface.label}:{surface.patch_name(patch.label)}"
+            )
         vertices = np.concatenate([s.vertices for s in surfaces.values()])
         faces = np.concatenate(pieces)
         used, compact = np.unique(faces, return_inverse=True)

@@ -16,15 +16,28 @@ checked by :class:`~geobrep.scene.Scene`, and the builder plugin fills the model
 from __future__ import annotations
 
 from functools import cached_property
-from typing import Self
+from typing import Any, Self
 
-from pydantic import Field, JsonValue, model_validator
+from pydantic import Field, JsonValue, ValidationError, model_validator
 
 from geobrep.arrays import Points, Vector3
 from geobrep.errors import TopologyError
 from geobrep.model import FrozenModel
 
 __all__ = ["Arc", "Corner", "Patch", "Topology"]
+
+
+class _TopologyModel(FrozenModel):
+    """Raises the :class:`TopologyError` its checks found rather than pydantic's wrapper."""
+
+    def __init__(self, **data: Any) -> None:
+        try:
+            super().__init__(**data)
+        except ValidationError as exc:
+            original = (exc.errors()[0].get("ctx") or {}).get("error")
+            if isinstance(original, TopologyError):
+                raise original from exc
+            raise
 
 
 class Corner(FrozenModel):
@@ -34,7 +47,7 @@ class Corner(FrozenModel):
     point: Vector3
 
 
-class Arc(FrozenModel):
+class Arc(_TopologyModel):
     """A boundary polyline ``points (K, 3)`` from corner ``start`` to corner ``end``."""
 
     id: int = Field(ge=0)
@@ -68,7 +81,7 @@ class Patch(FrozenModel):
         return self.positive_block is not None and self.positive_block == self.negative_block
 
 
-class Topology(FrozenModel):
+class Topology(_TopologyModel):
     """Corners, arcs and patches, each with ids unique within its kind."""
 
     corners: tuple[Corner, ...] = ()

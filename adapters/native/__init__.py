@@ -53,6 +53,7 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
                         "PolyLine",
                         "Polygon",
                         "Surface",
+                        "TetMesh",
                         "NurbsSurface",
                         "Annotation",
                         "Block",

@@ -6,7 +6,16 @@ import argparse
 import json
 from typing import Any
 
-from geobrep.entities import Block, Entity, LinearOctree, NurbsSurface, Polygon, PolyLine, Surface
+from geobrep.entities import (
+    Block,
+    Entity,
+    LinearOctree,
+    NurbsSurface,
+    Polygon,
+    PolyLine,
+    Surface,
+    TetMesh,
+)
 from geobrep.io import read
 from geobrep.properties import PropertyMap
 from geobrep.scene import Scene
@@ -44,6 +53,9 @@ def _counts(entity: Entity) -> dict[str, int]:
     if isinstance(entity, Surface):
         counts["faces"] = entity.n_faces
         counts["patches"] = entity.n_patches
+    elif isinstance(entity, TetMesh):
+        counts["tetrahedra"] = entity.n_cells
+        counts["regions"] = entity.n_regions
     elif isinstance(entity, PolyLine):
         counts["parts"] = entity.n_parts
         counts["segments"] = entity.n_cells

@@ -15,6 +15,7 @@ from geobrep.entities.pointset import PointSet
 from geobrep.entities.polygon import Polygon
 from geobrep.entities.polyline import PolyLine
 from geobrep.entities.surface import Surface
+from geobrep.entities.tetmesh import TetMesh
 
 __all__ = [
     "ENTITY_TYPES",
@@ -30,16 +31,35 @@ __all__ = [
     "PolyLine",
     "Polygon",
     "Surface",
+    "TetMesh",
     "VertexEntity",
 ]
 
 #: Every concrete entity class, by its ``type`` name.
 ENTITY_TYPES: dict[str, type[Entity]] = {
     cls.__name__: cls
-    for cls in (PointSet, PolyLine, Polygon, Surface, NurbsSurface, Annotation, Block, LinearOctree)
+    for cls in (
+        PointSet,
+        PolyLine,
+        Polygon,
+        Surface,
+        TetMesh,
+        NurbsSurface,
+        Annotation,
+        Block,
+        LinearOctree,
+    )
 }
 
 AnyEntity: TypeAlias = Annotated[
-    PointSet | PolyLine | Polygon | Surface | NurbsSurface | Annotation | Block | LinearOctree,
+    PointSet
+    | PolyLine
+    | Polygon
+    | Surface
+    | TetMesh
+    | NurbsSurface
+    | Annotation
+    | Block
+    | LinearOctree,
     Field(discriminator="type"),
 ]

@@ -10,7 +10,8 @@ from numpy.typing import NDArray
 from pydantic import Field, model_validator
 
 from geobrep.arrays import IndexArray, NumericArray, Vector3
-from geobrep.entities.base import Entity
+from geobrep.entities.base import Entity, describe_entity
+from geobrep.errors import EntityValidationError
 from geobrep.geometry.bbox import BoundingBox
 
 __all__ = ["MAX_OCTREE_DEPTH", "LinearOctree"]
@@ -49,19 +50,27 @@ class LinearOctree(Entity):
         if not isinstance(data, dict):
             return data
         data = dict(data)
+        label = describe_entity(cls.__name__, data.get("name"), data.get("id"))
         for key, dtype in (("codes", np.uint64), ("levels", np.uint8)):
             value = data.get(key)
             if value is None or isinstance(value, dict):
                 continue
-            array = np.asarray(value)
+            try:
+                array = np.asarray(value)
+            except (TypeError, ValueError) as exc:
+                raise EntityValidationError(
+                    label, key, f"cannot be read as an array: {exc}"
+                ) from None
             if array.dtype == dtype:
                 continue
             if array.dtype.kind not in "iu" and array.size:
-                raise ValueError(f"{key} must be integers, got dtype {array.dtype}")
+                raise EntityValidationError(
+                    label, key, f"must be integers, got dtype {array.dtype}"
+                )
             if array.size and array.min() < 0:
-                raise ValueError(f"{key} must be non-negative")
+                raise EntityValidationError(label, key, "must be non-negative")
             if key == "levels" and array.size and array.max() > MAX_OCTREE_DEPTH:
-                raise ValueError(f"levels must be ≤ {MAX_OCTREE_DEPTH}")
+                raise EntityValidationError(label, key, f"must be ≤ {MAX_OCTREE_DEPTH}")
             data[key] = array.astype(dtype)
         return data
 
@@ -118,7 +127,7 @@ class LinearOctree(Entity):
             raise self.fail(
                 "codes", f"leaf {bad} code is not aligned to its level {int(levels[bad])}"
             )
-        if self.depth < MAX_OCTREE_DEPTH and int(codes[-1]) >= 8**self.depth:
+        if int(codes[-1]) >= 8**self.depth:  # Python ints: exact at depth 21 (8**21 = 2**63)
             raise self.fail(
                 "codes", f"code {int(codes[-1])} lies outside an octree of depth {self.depth}"
             )

@@ -42,7 +42,7 @@ class PolyLine(VertexEntity):
         if isinstance(data, dict) and "vertices" in data and "indices" not in data:
             count = len(np.asarray(data["vertices"]))
             data = {**data, "indices": np.arange(count, dtype=np.int64)}
-            data.setdefault("part_offsets", np.array([0, count], dtype=np.int64))
+            data.setdefault("part_offsets", np.array([0, count] if count else [0], dtype=np.int64))
         if isinstance(data, dict) and "closed" not in data and "part_offsets" in data:
             parts = max(len(np.asarray(data["part_offsets"])) - 1, 0)
             data = {**data, "closed": np.zeros(parts, dtype=bool)}
