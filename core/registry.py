@@ -286,17 +286,26 @@ class FormatSpec(RegisteredItem):
 
 
 class ClipperSpec(RegisteredItem):
-    """Cuts one entity type by a plane: ``function(entity, plane, options) -> entity | None``.
+    """Cuts one entity type by a plane.
+
+    ``function(entity, plane, keep, options, context)`` returns the clipped entity (same type) or
+    ``None`` for ``keep="negative"`` / ``"positive"``, and the tuple ``(negative, positive)`` for
+    ``keep="both"``; ``context`` is a :class:`geobrep.clipping.ClipContext`. The optional
+    ``section(entity, plane, options, context)`` returns the cut itself (a lower-dimensional
+    entity on the plane) or ``None``.
 
     Example:
-        >>> ClipperSpec(name="pointset", entity_type="PointSet", function=lambda e, p, o: e).kind
-        'clipper'
+        >>> spec = ClipperSpec(name="pointset", entity_type="PointSet",
+        ...                    function=lambda entity, plane, keep, options, context: entity)
+        >>> spec.kind, spec.section is None
+        ('clipper', True)
     """
 
     kind: ClassVar[str] = "clipper"
 
     entity_type: str
     function: Callable[..., Any]
+    section: Callable[..., Any] | None = None
 
 
 class FitterSpec(RegisteredItem):

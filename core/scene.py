@@ -330,8 +330,8 @@ class Scene(FrozenModel):
             )
         vertices = np.concatenate([s.vertices for s in surfaces.values()])
         faces = np.concatenate(pieces)
-        used, compact = np.unique(faces, return_inverse=True)
-        vertices, faces = vertices[used], compact.reshape(faces.shape)
+        used, faces = mesh.compact_indices(faces, vertices.shape[0])
+        vertices = vertices[used]
         if tolerance is None:
             tolerance = RELATIVE_MERGE_TOLERANCE * (self.bounds.diagonal if self.bounds else 1.0)
         merged, inverse = mesh.merge_close_vertices(vertices, tolerance)
@@ -341,10 +341,10 @@ class Scene(FrozenModel):
             & (faces[:, 1] != faces[:, 2])
             & (faces[:, 0] != faces[:, 2])
         )
-        used, compact = np.unique(faces[keep], return_inverse=True)
+        used, compact = mesh.compact_indices(faces[keep], merged.shape[0])
         return Surface(
             vertices=merged[used],
-            faces=compact.reshape(-1, 3),
+            faces=compact,
             patch_labels=np.concatenate(labels)[keep],
             patch_names=tuple(names),
             name=target.name,
@@ -376,6 +376,17 @@ class Scene(FrozenModel):
         values = {name: getattr(self, name) for name in type(self).model_fields}
         values.update(changes)
         return Scene(**values)
+
+    def to_crs(self, target: Any, *, source: Any = None) -> Scene:
+        """This scene reprojected into ``target`` (see :func:`geobrep.crs_ops.to_crs`).
+
+        >>> import geobrep
+        >>> geobrep.datasets.faulted_layer_cake().to_crs("EPSG:32632").crs.label
+        'EPSG:32632'
+        """
+        from geobrep.crs_ops import to_crs
+
+        return to_crs(self, target, source=source)
 
     def __repr__(self) -> str:
         counts: dict[str, int] = defaultdict(int)

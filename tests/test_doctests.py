@@ -30,6 +30,7 @@ DOCTEST_MODULES = [
     "geobrep.entities.tetmesh",
     "geobrep.scene",
     "geobrep.io",
+    "geobrep.voxelization",
     "geobrep.datasets.layer_cake",
     "geobrep.datasets.scattered",
     "geobrep.schemas",

@@ -58,10 +58,15 @@ def save(scene: Scene, path: str | Path, compress: bool = False) -> Path:
 
 def _write_container(scene: Scene, path: Path, compress: bool) -> None:
     arrays: list[tuple[str, NDArray[Any]]] = []
+    stored: dict[int, str] = {}
 
     def store(array: NDArray[Any]) -> str:
-        name = f"arrays/{len(arrays):06d}.npy"
-        arrays.append((name, array))
+        # pydantic may serialise a union member more than once while it picks the matching
+        # type: store each array object once (the scene keeps them alive during the save).
+        name = stored.get(id(array))
+        if name is None:
+            name = stored[id(array)] = f"arrays/{len(arrays):06d}.npy"
+            arrays.append((name, array))
         return name
 
     document = NativeDocument(scene=scene).model_dump(mode="json", context={ARRAY_WRITER: store})

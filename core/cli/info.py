@@ -16,6 +16,7 @@ from geobrep.entities import (
     Surface,
     TetMesh,
 )
+from geobrep.errors import GeobrepError
 from geobrep.io import read
 from geobrep.properties import PropertyMap
 from geobrep.scene import Scene
@@ -86,12 +87,29 @@ def describe_entity(entity: Entity) -> dict[str, Any]:
     }
 
 
+def _parsed_crs(scene: Scene) -> dict[str, Any] | None:
+    """What pyproj reads in the scene's CRS (name, units, vertical datum), when it is there."""
+    if scene.crs is None:
+        return None
+    try:
+        from geobrep.crs_ops import describe_crs
+    except ImportError:  # pragma: no cover - crs_ops itself is always importable
+        return None
+    try:
+        return describe_crs(scene.crs)
+    except ImportError:  # pyproj (the gis extra) is not installed
+        return None
+    except GeobrepError as exc:
+        return {"error": str(exc)}
+
+
 def describe_scene(scene: Scene) -> dict[str, Any]:
     """A JSON-ready summary of a scene."""
     bounds = scene.bounds
     return {
         "name": scene.name,
         "crs": scene.crs.model_dump(mode="json") if scene.crs else None,
+        "crs_parsed": _parsed_crs(scene),
         "bounds": list(bounds.as_tuple()) if bounds is not None else None,
         "entities": [describe_entity(e) for e in scene.entities],
         "topology": {
@@ -125,6 +143,7 @@ def render_text(summary: dict[str, Any], source: str) -> str:
     lines = [
         f"{source}: {len(summary['entities'])} entities",
         f"  CRS     {crs_text}",
+        *_parsed_crs_lines(summary.get("crs_parsed")),
         f"  bounds  {_format_bounds(summary['bounds'])}",
     ]
     topo = summary["topology"]
@@ -144,6 +163,18 @@ def render_text(summary: dict[str, Any], source: str) -> str:
                 size = f"×{prop['element_size']}" if prop["element_size"] > 1 else ""
                 lines.append(f"      {where} {prop['name']!r}: {prop['dtype']}{size}{unit}")
     return "\n".join(lines)
+
+
+def _parsed_crs_lines(parsed: dict[str, Any] | None) -> list[str]:
+    if not parsed:
+        return []
+    if "error" in parsed:
+        return [f"          not understood by pyproj: {parsed['error']}"]
+    datum = parsed.get("vertical_datum") or "none given"
+    return [
+        f"          {parsed['name']} ({parsed['type']}; units {', '.join(parsed['units'])}; "
+        f"vertical units {parsed['vertical_units']}; vertical datum {datum})"
+    ]
 
 
 def run(args: argparse.Namespace) -> int:

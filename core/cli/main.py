@@ -8,14 +8,31 @@ import sys
 import traceback
 from collections.abc import Sequence
 
-from geobrep.cli import demo, info, plugins
+import importlib
+from types import ModuleType
+
 from geobrep.errors import GeobrepError
 
 __all__ = ["build_parser", "main"]
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 70, 130
 
-_COMMANDS = (info, plugins, demo)
+#: Subcommand modules of ``geobrep.cli``, each with ``add_parser(subparsers)``, in help order.
+COMMAND_MODULES = (
+    "info", "plugins", "demo", "convert", "render", "reproject",
+    "clip", "section", "blocks", "voxelize", "fit",
+)
+
+
+def _command_modules() -> list[ModuleType]:
+    modules = []
+    for name in COMMAND_MODULES:
+        try:
+            modules.append(importlib.import_module(f"geobrep.cli.{name}"))
+        except ModuleNotFoundError as exc:  # TEMPORARY while commands are being added
+            if exc.name != f"geobrep.cli.{name}":
+                raise
+    return modules
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -28,7 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"geobrep {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for command in _COMMANDS:
+    for command in _command_modules():
         command.add_parser(subparsers)
     return parser
 

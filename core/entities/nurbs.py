@@ -3,14 +3,19 @@
 from __future__ import annotations
 
 from functools import cached_property
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from pydantic import Field, model_validator
 
+from geobrep import nurbs_eval
 from geobrep.arrays import ControlNet, FloatArray, WeightGrid
 from geobrep.entities.base import Entity
 from geobrep.geometry.bbox import BoundingBox
+
+if TYPE_CHECKING:
+    from geobrep.entities.surface import Surface
 
 __all__ = ["NurbsSurface"]
 
@@ -61,6 +66,84 @@ class NurbsSurface(Entity):
     def is_rational(self) -> bool:
         return (
             not bool(np.all(self.weights == self.weights.flat[0])) if self.weights.size else False
+        )
+
+    @property
+    def domain(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """Parameter domain ``((u_min, u_max), (v_min, v_max))``."""
+        nu, nv = self.shape
+        return (
+            (float(self.knots_u[self.degree_u]), float(self.knots_u[nu])),
+            (float(self.knots_v[self.degree_v]), float(self.knots_v[nv])),
+        )
+
+    def _eval_args(self) -> nurbs_eval.SurfaceArgs:
+        weights = self.weights if self.is_rational else None
+        return (
+            self.degree_u,
+            self.degree_v,
+            self.knots_u,
+            self.knots_v,
+            self.control_points,
+            weights,
+        )
+
+    def evaluate(self, u: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
+        """Surface points at parameter pairs ``(u[i], v[i])``: shape ``(m, 3)``.
+
+        >>> net = np.zeros((2, 2, 3)); net[1, :, 0] = 1; net[:, 1, 1] = 1
+        >>> s = NurbsSurface(degree_u=1, degree_v=1, knots_u=[0, 0, 1, 1], knots_v=[0, 0, 1, 1],
+        ...                  control_points=net)
+        >>> s.evaluate([0.5], [0.25]).tolist()
+        [[0.5, 0.25, 0.0]]
+        """
+        return nurbs_eval.surface_points(*self._eval_args(), u, v)
+
+    def derivatives(self, u: ArrayLike, v: ArrayLike, order: int = 1) -> NDArray[np.float64]:
+        """Partial derivatives ``[:, k, l] = ∂^(k+l)S/∂u^k∂v^l`` (``k + l <= order``)."""
+        return nurbs_eval.surface_derivatives(*self._eval_args(), u, v, order=order)
+
+    def tessellate(
+        self, resolution: int | tuple[int, int] | None = None, tolerance: float | None = None
+    ) -> Surface:
+        """A triangle mesh of the surface on a parameter grid.
+
+        ``resolution`` is the number of samples per direction; ``tolerance`` refines a grid that
+        keeps the knot lines until the mesh is within ``tolerance`` of the surface (checked at cell
+        centres and edge midpoints). The mesh has point properties ``u`` and ``v`` and metadata
+        ``grid_shape`` and ``deviation``.
+
+        >>> net = np.zeros((2, 2, 3)); net[1, :, 0] = 1; net[:, 1, 1] = 1
+        >>> s = NurbsSurface(degree_u=1, degree_v=1, knots_u=[0, 0, 1, 1], knots_v=[0, 0, 1, 1],
+        ...                  control_points=net)
+        >>> mesh = s.tessellate(resolution=3)
+        >>> mesh.n_vertices, mesh.n_faces, mesh.area
+        (9, 8, 1.0)
+        """
+        from geobrep.entities.surface import Surface
+
+        if resolution is not None and tolerance is not None:
+            raise self.fail("tessellate", "give resolution or tolerance, not both")
+        if tolerance is not None and not tolerance > 0:
+            raise self.fail("tessellate", f"tolerance must be > 0, got {tolerance}")
+        try:
+            grid = nurbs_eval.tessellate(
+                *self._eval_args(), resolution=resolution, tolerance=tolerance
+            )
+        except ValueError as exc:
+            raise self.fail("tessellate", str(exc)) from exc
+        uu, vv = np.meshgrid(grid.u, grid.v, indexing="ij")
+        return Surface(
+            vertices=grid.vertices,
+            faces=grid.faces,
+            name=self.name,
+            kind=self.kind,
+            metadata={
+                **self.metadata,
+                "grid_shape": [int(grid.u.shape[0]), int(grid.v.shape[0])],
+                "deviation": grid.deviation,
+            },
+            point_data={"u": uu.reshape(-1), "v": vv.reshape(-1)},
         )
 
     @cached_property

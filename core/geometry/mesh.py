@@ -16,6 +16,7 @@ from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
 
 __all__ = [
     "boundary_edges",
+    "compact_indices",
     "edge_face_counts",
     "edge_face_incidence",
     "face_areas",
@@ -389,6 +390,53 @@ def is_consistently_oriented(faces: ArrayLike) -> bool:
 
 
 # --------------------------------------------------------------------------- vertices
+def _merge_candidates(local: FloatArray, tol: float) -> IntArray:
+    """Vertices that may lie within ``tol`` of another one (a superset; pairs are checked after).
+
+    Vertices are binned in cubes of side about ``1000 · tol``: two vertices within ``tol`` of each
+    other share a cube or both lie within ``tol`` of a cube face, so only vertices in crowded
+    cubes or near a face need the exact k-d tree search — a small share of a mesh whose vertex
+    spacing exceeds the tolerance. Falls back to every vertex when the cubes cannot be keyed.
+    """
+    n = local.shape[0]
+    everything = np.arange(n, dtype=np.int64)
+    # An odd cube size and a shifted origin keep lattice-aligned vertices off the cube faces.
+    cell = 1021.37 * tol
+    reach = float(np.abs(local).max()) if n else 0.0
+    if cell <= 1e-9 * reach or reach / cell > 2.0**19:
+        return everything
+    shifted = local + 0.3819 * cell
+    scaled = np.floor(shifted / cell)
+    offsets = shifted - scaled * cell
+    margin = 2.0 * tol + 8.0 * np.finfo(np.float64).eps * reach
+    near_face = ((offsets <= margin) | (offsets >= cell - margin)).any(axis=1)
+    cubes = scaled.astype(np.int64)
+    cubes -= cubes.min(axis=0)
+    dims = cubes.max(axis=0) + 1
+    keys = (cubes[:, 0] * dims[1] + cubes[:, 1]) * dims[2] + cubes[:, 2]
+    sorted_keys, order = _stable_sort(keys)
+    same = sorted_keys[1:] == sorted_keys[:-1]
+    crowded = np.zeros(n, dtype=np.bool_)
+    crowded[order[1:][same]] = True
+    crowded[order[:-1][same]] = True
+    return np.flatnonzero(near_face | crowded).astype(np.int64)
+
+
+def compact_indices(indices: ArrayLike, n: int) -> tuple[IntArray, IntArray]:
+    """The used values of ``indices`` (all in ``[0, n)``), sorted, and ``indices`` renumbered
+    into them — ``np.unique(indices, return_inverse=True)`` in linear time.
+
+    >>> used, renumbered = compact_indices([[4, 1, 7], [7, 1, 9]], 10)
+    >>> used.tolist(), renumbered.tolist()
+    ([1, 4, 7, 9], [[1, 0, 2], [2, 0, 3]])
+    """
+    arr = np.asarray(indices, dtype=np.int64)
+    present = np.zeros(n, dtype=np.bool_)
+    present[arr.reshape(-1)] = True
+    rank = np.cumsum(present, dtype=np.int64) - 1
+    return np.flatnonzero(present).astype(np.int64), rank[arr]
+
+
 def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatArray, IntArray]:
     """Merge vertices within ``tolerance`` of each other: ``(unique_vertices, inverse (N,))``.
 
@@ -416,12 +464,16 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
         from scipy.sparse.csgraph import connected_components
         from scipy.spatial import cKDTree
 
-        pairs = cKDTree(verts - centre).query_pairs(r=tol, output_type="ndarray")
+        local = verts - centre
+        candidates = _merge_candidates(local, tol)
+        pairs = cKDTree(local[candidates]).query_pairs(r=tol, output_type="ndarray")
+        pairs = candidates[pairs]
         graph = coo_matrix(
             (np.ones(pairs.shape[0], dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n)
         )
-        _, labels = connected_components(graph, directed=False)
-        _, first = np.unique(labels, return_index=True)
+        n_groups, labels = connected_components(graph, directed=False)
+        first = np.full(n_groups, n, dtype=np.int64)
+        np.minimum.at(first, labels, np.arange(n, dtype=np.int64))  # lowest index per group
     # first[g] is the lowest index of group g; renumber groups by that index.
     order = np.argsort(first)
     rank = np.empty(order.shape[0], dtype=np.int64)

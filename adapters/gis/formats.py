@@ -1,0 +1,443 @@
+"""Readers, writers and sniffers of GeoPackage, GeoJSON and shapefile (pyogrio + shapely 2).
+
+A GeoPackage holds several layers and the full geobrep CRS (in the dataset metadata, beside
+GDAL's own CRS); a GeoJSON file holds one FeatureCollection, so several layers are written into
+it with a ``layer`` column that the reader splits again; a shapefile holds one layer (choose it
+with ``layer=`` when a scene makes several).
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import re
+import shutil
+import tempfile
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import ConfigDict
+
+from geobrep.crs import CRS
+from geobrep.errors import FormatError, MissingDependencyError
+from geobrep.feature_tables import (
+    RESERVED_COLUMNS,
+    FeatureTable,
+    FeatureWarning,
+    ReadOptions,
+    entities_to_tables,
+    tables_to_entities,
+)
+from geobrep.registry import FormatCapabilities, FormatSpec
+from geobrep.scene import Scene
+
+__all__ = ["GisOptions", "gis_formats", "looks_like_geojson", "read_gis", "write_gis"]
+
+#: Dataset metadata key of the GeoPackage that keeps the complete geobrep CRS.
+CRS_METADATA_KEY = "geobrep_crs"
+LAYER_COLUMN = "layer"
+_GEOMETRY_TYPES = {0: "Point Z", 1: "LineString Z", 2: "LineString Z", 3: "Polygon Z"}
+_DRIVERS = {"gpkg": "GPKG", "geojson": "GeoJSON", "shapefile": "ESRI Shapefile"}
+_SHAPEFILE_SIDECARS = (".shx", ".dbf", ".prj", ".cpg")
+
+
+class GisOptions(ReadOptions):
+    """``layer``: read only this layer, or write only the entities of this layer.
+
+    ``z_field`` / ``z_default``: z of 2D features, from a column or a constant.
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    layer: str | None = None
+
+
+def _pyogrio() -> Any:
+    try:
+        pyogrio = importlib.import_module("pyogrio")  # untyped: kept Any
+        importlib.import_module("pyogrio.raw")
+    except ImportError as exc:  # pragma: no cover - exercised only without the extra
+        raise MissingDependencyError("pyogrio", "gis", "GIS formats") from exc
+    # GDAL would leave a ".aux.xml" beside files it only read: GeoPackage keeps its metadata inside
+    pyogrio.set_gdal_config_options({"GDAL_PAM_ENABLED": "NO"})
+    return pyogrio
+
+
+def _final_name(path: Path) -> Path:
+    """The name the user asked for, from the temporary name :func:`geobrep.io.atomic_write` uses."""
+    return path.with_name(re.sub(r"^\.(.*)\.tmp-[0-9a-f]+(\.[^.]*)?$", r"\1\2", path.name))
+
+
+def looks_like_geojson(head: bytes) -> bool:
+    """True when the first bytes are a GeoJSON FeatureCollection (for ``.json`` files).
+
+    >>> looks_like_geojson(b'{"type": "FeatureCollection", "features": []}')
+    True
+    >>> looks_like_geojson(b'{"entities": []}')
+    False
+    """
+    text = head.lstrip(b"\xef\xbb\xbf \t\r\n")
+    return (
+        text.startswith(b"{") and re.search(rb'"type"\s*:\s*"FeatureCollection"', text) is not None
+    )
+
+
+# -- CRS ----------------------------------------------------------------------------------------
+def _crs_for_layer(text: str | None, stored: CRS | None) -> CRS | None:
+    if not text:
+        return None
+    from geobrep.crs_ops import CRSError, crs_from_user_input
+
+    try:
+        parsed = crs_from_user_input(text)
+    except CRSError as exc:
+        warnings.warn(
+            f"unknown CRS {text[:60]!r}: {exc}; kept as text", FeatureWarning, stacklevel=4
+        )
+        return CRS(wkt=text) if "[" in text else CRS(name=text)
+    if stored is not None and (stored.epsg is None or stored.epsg == parsed.epsg):
+        return stored
+    return parsed
+
+
+def _crs_text(crs: CRS | None) -> str | None:
+    if crs is None:
+        return None
+    if crs.epsg is not None and not crs.vertical_datum:
+        return f"EPSG:{crs.epsg}"
+    from geobrep.crs_ops import CRSError, parse_crs
+
+    try:
+        return str(parse_crs(crs).to_wkt())
+    except CRSError:
+        return crs.wkt or crs.proj
+
+
+_GEOJSON_CRS = re.compile(rb'"crs"\s*:\s*\{.*?"name"\s*:\s*"([^"]+)"', re.DOTALL)
+
+
+def _geojson_crs(path: Path, crs: CRS | None) -> CRS | None:
+    """Check the ``crs`` member of a GeoJSON file ourselves: GDAL silently falls back to
+    WGS 84 when it cannot understand it."""
+    with path.open("rb") as handle:
+        head = handle.read(1 << 16)
+    found = _GEOJSON_CRS.search(head)
+    if found is None:
+        return crs  # RFC 7946: WGS 84 longitude/latitude, as GDAL says
+    declared = found.group(1).decode("utf-8", "replace")
+    from geobrep.crs_ops import CRSError, crs_from_user_input
+
+    try:
+        return crs_from_user_input(declared)
+    except CRSError as exc:
+        warnings.warn(
+            f"{path}: the CRS {declared!r} is unknown ({exc}); the scene has no CRS",
+            FeatureWarning,
+            stacklevel=4,
+        )
+        return None
+
+
+def _stored_crs(info: dict[str, Any]) -> CRS | None:
+    metadata = info.get("dataset_metadata") or {}
+    text = metadata.get(CRS_METADATA_KEY)
+    if not text:
+        return None
+    try:
+        return CRS.model_validate(json.loads(text))
+    except (ValueError, TypeError):
+        return None
+
+
+# -- reading ------------------------------------------------------------------------------------
+def _shapefile_columns(columns: dict[str, NDArray[Any]]) -> dict[str, NDArray[Any]]:
+    """Undo the 10-character truncation of shapefile field names for geobrep's own columns."""
+    full = {name[:10]: name for name in (*RESERVED_COLUMNS, LAYER_COLUMN) if len(name) > 10}
+    return {full.get(name, name): values for name, values in columns.items()}
+
+
+def _read_layer(path: Path, layer: str, driver: str) -> tuple[list[FeatureTable], str | None]:
+    pyogrio = _pyogrio()
+    meta, fids, geometry, field_data = pyogrio.raw.read(path, layer=layer, return_fids=True)
+    columns = {str(name): values for name, values in zip(meta["fields"], field_data, strict=True)}
+    if driver == "ESRI Shapefile":
+        columns = _shapefile_columns(columns)
+    geometry = np.asarray(geometry, dtype=object)
+    fids = np.asarray(fids, dtype=np.int64)
+    split = columns.pop(LAYER_COLUMN, None) if driver == "GeoJSON" else None
+    if split is None or np.asarray(split).dtype != object:
+        if split is not None:
+            columns[LAYER_COLUMN] = split
+        return [FeatureTable(layer=layer, geometry=geometry, columns=columns, fids=fids)], meta.get(
+            "crs"
+        )
+    names = np.asarray([layer if v is None else str(v) for v in split.tolist()], dtype=object)
+    integer = {str(n) for n, t in zip(meta["fields"], meta["dtypes"], strict=True) if "int" in t}
+    tables = []
+    for name in dict.fromkeys(names.tolist()):
+        rows = np.flatnonzero(names == name)
+        tables.append(
+            FeatureTable(
+                layer=str(name),
+                geometry=geometry[rows],
+                columns=_layer_columns(columns, rows, integer),
+                fids=fids[rows],
+            )
+        )
+    return tables, meta.get("crs")
+
+
+def _layer_columns(
+    columns: dict[str, NDArray[Any]], rows: NDArray[np.int64], integer: set[str]
+) -> dict[str, NDArray[Any]]:
+    """The columns of one layer of a merged GeoJSON file: other layers' columns dropped, and
+    integer columns that GDAL widened to float (nulls elsewhere) made integer again."""
+    result: dict[str, NDArray[Any]] = {}
+    for name, column in columns.items():
+        values = column[rows]
+        if values.dtype == object:
+            if all(v is None for v in values.tolist()):
+                continue
+        elif values.dtype.kind == "f":
+            finite = np.isfinite(values)
+            if not finite.any():
+                continue
+            if name in integer and finite.all():
+                values = values.astype(np.int64)
+        result[name] = values
+    return result
+
+
+def read_gis(path: Path, options: GisOptions, driver: str) -> Scene:
+    """Read every layer (or ``options.layer``) of a GIS vector file into a scene."""
+    pyogrio = _pyogrio()
+    try:
+        listed = pyogrio.list_layers(path)
+    except Exception as exc:  # GDAL cannot open it: say which file
+        raise FormatError(f"not a readable {driver} file: {exc}", path) from exc
+    names = [str(row[0]) for row in listed]
+    if options.layer is not None and options.layer not in names and driver != "GeoJSON":
+        raise FormatError(f"no layer {options.layer!r} (layers: {', '.join(names)})", path)
+    stored = _stored_crs(pyogrio.read_info(path, layer=names[0])) if names else None
+    tables: list[FeatureTable] = []
+    crs_by_layer: dict[str, str | None] = {}
+    for name in names:
+        if options.layer is not None and driver != "GeoJSON" and name != options.layer:
+            continue
+        layer_tables, crs_text = _read_layer(path, name, driver)
+        for table in layer_tables:
+            if options.layer is not None and table.layer != options.layer:
+                continue
+            tables.append(table)
+            crs_by_layer[table.layer] = crs_text
+    if options.layer is not None and not tables:
+        raise FormatError(f"no layer {options.layer!r}", path)
+    known = {text for text in crs_by_layer.values() if text}
+    missing = sorted(name for name, text in crs_by_layer.items() if not text)
+    if len(known) > 1:
+        listing = "; ".join(f"{n}: {t[:40] if t else 'none'}" for n, t in crs_by_layer.items())
+        raise FormatError(
+            f"layers have different CRSs ({listing}): read them one at a time with layer=", path
+        )
+    if missing:
+        warnings.warn(
+            f"{path}: layer(s) {', '.join(repr(m) for m in missing)} have no CRS: the CRS is "
+            "unknown (set scene.crs before reprojecting)",
+            FeatureWarning,
+            stacklevel=3,
+        )
+    crs = _crs_for_layer(next(iter(known)), stored) if known else None
+    if driver == "GeoJSON":
+        crs = _geojson_crs(path, crs)
+    entities = tables_to_entities(tables, options, source=str(path))
+    return Scene(entities=entities, crs=crs, name=path.stem)
+
+
+# -- writing ------------------------------------------------------------------------------------
+def _geometry_type(table: FeatureTable) -> str:
+    shapely = importlib.import_module("shapely")
+    types = set(shapely.get_type_id(table.geometry).tolist())
+    return _GEOMETRY_TYPES[min(types)] if len(types) == 1 else "Unknown"
+
+
+def _fields(
+    columns: dict[str, NDArray[Any]],
+) -> tuple[list[NDArray[Any]], list[str], list[NDArray[np.bool_] | None]]:
+    data: list[NDArray[Any]] = []
+    names: list[str] = []
+    masks: list[NDArray[np.bool_] | None] = []
+    for name, values in columns.items():
+        names.append(name)
+        if np.ma.isMaskedArray(values):
+            mask = np.ma.getmaskarray(values)
+            data.append(np.asarray(values.data))
+            masks.append(mask)
+        else:
+            data.append(np.asarray(values))
+            masks.append(None)
+    return data, names, masks
+
+
+def _merged_for_single_layer(tables: list[FeatureTable]) -> FeatureTable:
+    from geobrep.feature_tables import merge_columns
+
+    pieces = [
+        (len(t), {LAYER_COLUMN: np.full(len(t), t.layer, dtype=object), **t.columns})
+        for t in tables
+    ]
+    return FeatureTable(
+        layer=tables[0].layer if len(tables) == 1 else "layers",
+        geometry=np.concatenate([t.geometry for t in tables]),
+        columns=merge_columns(pieces),
+    )
+
+
+def _write_tables(tables: list[FeatureTable], path: Path, driver: str, crs: CRS | None) -> None:
+    pyogrio = _pyogrio()
+    shapely = importlib.import_module("shapely")
+
+    crs_text = _crs_text(crs)
+    for position, table in enumerate(tables):
+        data, names, masks = _fields(table.columns)
+        kwargs: dict[str, Any] = {}
+        if driver == "GPKG" and position == 0 and crs is not None:
+            kwargs["dataset_metadata"] = {CRS_METADATA_KEY: crs.model_dump_json()}
+        if driver == "GeoJSON":
+            kwargs["layer_options"] = {"WRITE_NAME": "YES", "SIGNIFICANT_FIGURES": "17"}
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message=".*[Nn]ormalized/laundered.*")
+            warnings.filterwarnings("ignore", message=".*truncated.*")
+            warnings.filterwarnings("ignore", message=".*'crs' was not provided.*")
+            pyogrio.raw.write(
+                path,
+                shapely.to_wkb(table.geometry, include_srid=False, output_dimension=3),
+                data,
+                names,
+                field_mask=masks if any(m is not None for m in masks) else None,
+                layer=table.layer,
+                driver=driver,
+                geometry_type=_geometry_type(table),
+                crs=crs_text,
+                append=position > 0,
+                promote_to_multi=False,
+                **kwargs,
+            )
+
+
+def _shapefile_write(table: FeatureTable, path: Path, crs: CRS | None) -> None:
+    """Write a shapefile set: ``path`` is the (temporary) .shp; sidecars get the final stem."""
+    final_stem = _final_name(path).stem
+    long_names = [n for n in table.columns if len(n) > 10 and n not in RESERVED_COLUMNS]
+    if long_names:
+        warnings.warn(
+            f"{_final_name(path)}: shapefile field names are cut to 10 "
+            f"characters: {', '.join(long_names)}",
+            FeatureWarning,
+            stacklevel=4,
+        )
+    with tempfile.TemporaryDirectory(dir=path.parent, prefix=".shp-") as folder:
+        staging = Path(folder) / f"{final_stem}.shp"
+        _write_tables([table], staging, "ESRI Shapefile", crs)
+        for sidecar in _SHAPEFILE_SIDECARS:
+            produced = staging.with_suffix(sidecar)
+            if produced.exists():
+                shutil.move(str(produced), str(path.with_name(final_stem + sidecar)))
+        shutil.move(str(staging), str(path))
+
+
+def write_gis(scene: Scene, path: Path, options: GisOptions, driver: str) -> None:
+    """Write the scene's points, lines, polygons and annotations as layers."""
+    tables = list(entities_to_tables(scene.entities).values())
+    if options.layer is not None:
+        tables = [t for t in tables if t.layer == options.layer]
+        if not tables:
+            raise FormatError(f"the scene has no entities for layer {options.layer!r}", path)
+    if not tables:
+        raise FormatError(
+            "nothing to write: GIS layers hold PointSets, PolyLines, Polygons and Annotations",
+            path,
+        )
+    if scene.crs is None:
+        warnings.warn(
+            f"{_final_name(path)}: the scene has no CRS; the layers are written without one",
+            FeatureWarning,
+            stacklevel=3,
+        )
+    if driver == "GeoJSON":
+        _write_tables([_merged_for_single_layer(tables)], path, driver, scene.crs)
+    elif driver == "ESRI Shapefile":
+        if len(tables) > 1:
+            names = ", ".join(t.layer for t in tables)
+            raise FormatError(
+                f"a shapefile holds one layer, the scene makes {len(tables)} ({names}): "
+                "choose one with layer=",
+                path,
+            )
+        _shapefile_write(tables[0], path, scene.crs)
+    else:
+        _write_tables(tables, path, driver, scene.crs)
+
+
+def _reader(driver: str) -> Any:
+    def read(path: Path, options: GisOptions) -> Scene:
+        return read_gis(path, options, driver)
+
+    return read
+
+
+def _writer(driver: str) -> Any:
+    def write(scene: Scene, path: Path, options: GisOptions) -> None:
+        write_gis(scene, path, options, driver)
+
+    return write
+
+
+def _looks_like_geopackage(head: bytes) -> bool:
+    return head.startswith(b"SQLite format 3\x00") and b"GPKG" in head[60:72]
+
+
+def gis_formats() -> list[FormatSpec]:
+    """The three GIS format specs."""
+    capabilities = FormatCapabilities(
+        entity_types=frozenset({"PointSet", "PolyLine", "Polygon", "Annotation"}),
+        point_data=True,
+        cell_data=True,
+        names=True,
+        ids=True,
+        crs=True,
+        multiple_entities=True,
+    )
+    return [
+        FormatSpec(
+            name="gpkg",
+            description="OGC GeoPackage: layers of points, lines, polygons with attributes",
+            extensions=(".gpkg",),
+            reader=_reader(_DRIVERS["gpkg"]),
+            writer=_writer(_DRIVERS["gpkg"]),
+            sniff=_looks_like_geopackage,
+            options=GisOptions,
+            capabilities=capabilities,
+        ),
+        FormatSpec(
+            name="geojson",
+            description="GeoJSON FeatureCollection (.geojson, or .json by content)",
+            extensions=(".geojson",),
+            reader=_reader(_DRIVERS["geojson"]),
+            writer=_writer(_DRIVERS["geojson"]),
+            sniff=looks_like_geojson,
+            options=GisOptions,
+            capabilities=capabilities,
+        ),
+        FormatSpec(
+            name="shapefile",
+            description="ESRI shapefile (.shp with .shx, .dbf, .prj): one layer",
+            extensions=(".shp",),
+            reader=_reader(_DRIVERS["shapefile"]),
+            writer=_writer(_DRIVERS["shapefile"]),
+            options=GisOptions,
+            capabilities=capabilities,
+        ),
+    ]

@@ -1,0 +1,34 @@
+"""Options of the ``gocad`` format (one model for reading and writing, as the registry wants)."""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from geobrep.arcs import DEFAULT_RELATIVE_TOLERANCE
+
+__all__ = ["GocadOptions"]
+
+
+class GocadOptions(BaseModel):
+    """Options of the ``gocad`` format.
+
+    >>> GocadOptions(vertex_ids=True).vertex_ids
+    True
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    vertex_ids: bool = False
+    """Reading: add the file's vertex ids as the point property ``gocad_vertex_id``."""
+    merge_tolerance: float | None = Field(default=None, ge=0)
+    """Reading: distance under which vertices of different surfaces are one point when a
+    Model3d's corners and arcs are rebuilt (default: 1e-8 of the bounding-box diagonal)."""
+    object_type: str | None = None
+    """Writing: ``TSurf``, ``PLine``, ``VSet``, ``TSolid``, ``Model3d`` or
+    ``HeterogeneousGroup``; default: from the extension (.ts .pl .vs .so .ml .gp)."""
+
+    def merge_tolerance_for(self, diagonal: float) -> float:
+        """The joining distance for a model whose bounding-box diagonal is ``diagonal``."""
+        if self.merge_tolerance is not None:
+            return self.merge_tolerance
+        return DEFAULT_RELATIVE_TOLERANCE * (diagonal if diagonal > 0 else 1.0)

@@ -1,0 +1,782 @@
+"""Parse a GOCAD ASCII file into :class:`GocadObject` records (no geobrep entities yet).
+
+One object is ``GOCAD <Type> <version>``, ``HEADER {...}``, an optional CRS block, geology
+lines, property headers, a body and ``END``. Files can hold several objects and groups
+(``BEGIN_MEMBERS ... END_MEMBERS``). Unknown object types (SGrid, Voxet, Well, ...) are
+skipped with a warning. Every recovered oddity is a :class:`GocadWarning`; every
+unrecoverable one a :class:`~geobrep.errors.FormatError` with the path and line.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from geobrep.adapters.gocad.headers import (
+    PROPERTY_KEYWORDS,
+    PropertyHeader,
+    parse_property_line,
+)
+from geobrep.adapters.gocad.lexer import (
+    BulkParseError,
+    Line,
+    Run,
+    Source,
+    parse_run,
+    scan,
+    split_tokens,
+)
+from geobrep.adapters.gocad.numbers import parse_float, parse_int
+from geobrep.adapters.gocad.tables import CellTable, ResolvedVertices, VertexTable, check_finite_ids
+from geobrep.errors import FormatError
+
+__all__ = ["GocadObject", "GocadWarning", "parse_source"]
+
+#: Object types with a reader, by lowercase spelling (``Vset`` and ``PLINE`` occur).
+KNOWN_TYPES = {
+    "tsurf": "TSurf",
+    "pline": "PLine",
+    "vset": "VSet",
+    "tsolid": "TSolid",
+    "lighttsolid": "LightTSolid",
+    "model3d": "Model3d",
+    "heterogeneousgroup": "HeterogeneousGroup",
+    "homogeneousgroup": "HomogeneousGroup",
+}
+GROUP_TYPES = ("HeterogeneousGroup", "HomogeneousGroup")
+FLAG_NAMES = {"CNXYZ": 1, "XYZ": 2}
+_CELL_PREFIX = {"TSurf": "TRGL_", "PLine": "SEG_", "TSolid": "TETRA_", "LightTSolid": "TETRA_"}
+_CELL_WIDTH = {"TSurf": 3, "PLine": 2, "TSolid": 4, "LightTSolid": 4, "Model3d": 3}
+_CELL_KEYWORD = {"TSurf": "TRGL", "PLine": "SEG", "TSolid": "TETRA", "LightTSolid": "TETRA"}
+_PART_KEYWORDS = {"TFACE", "3DFACE", "ILINE", "TVOLUME", "SUBVSET"}
+_SKIP_BLOCKS = {
+    "BEGIN_ATOM_REGION_INDICATORS": "END_ATOM_REGION_INDICATORS",
+    "PROPERTY_CN": "END_PROPERTY_CN",
+}
+
+
+class GocadWarning(UserWarning):
+    """A recoverable oddity in a GOCAD file (the message says where and what was done)."""
+
+
+@dataclass
+class GocadObject:
+    """One object of a GOCAD file, parsed but not yet turned into entities."""
+
+    type: str
+    version: str
+    line: int
+    header: list[tuple[str, str]] = field(default_factory=list)
+    crs: dict[str, Any] | None = None
+    geology: dict[str, Any] = field(default_factory=dict)
+    point_header: PropertyHeader = field(default_factory=PropertyHeader)
+    cell_header: PropertyHeader = field(default_factory=PropertyHeader)
+    class_headers: dict[str, dict[str, str]] = field(default_factory=dict)
+    vertices: ResolvedVertices | None = None
+    cells: tuple[Any, ...] | None = None  # (ids, values, parts, lines) from CellTable.finish
+    part_names: list[str] = field(default_factory=list)
+    part_vertex_starts: list[int] = field(default_factory=list)
+    bstones: list[tuple[int, int]] = field(default_factory=list)  # (vertex id, line)
+    borders: list[tuple[int, int, int, int]] = field(default_factory=list)  # (new, v0, v1, line)
+    ctetra: list[tuple[int, str, list[str], int]] = field(default_factory=list)
+    model: dict[str, Any] = field(default_factory=dict)  # Model3d header / TSolid MODEL
+    members: list[GocadObject] = field(default_factory=list)
+    extra_lines: list[str] = field(default_factory=list)
+
+    @property
+    def name(self) -> str:
+        for key, value in self.header:
+            if key.lower() == "name":
+                return value
+        return ""
+
+    def header_value(self, key: str) -> str | None:
+        for k, value in self.header:
+            if k == key:
+                return value
+        return None
+
+
+class _Stream:
+    """Items of the file with one-item look-ahead."""
+
+    def __init__(self, source: Source) -> None:
+        self.source = source
+        self._items: Iterator[Line | Run] = scan(source)
+        self._next: Line | Run | None = None
+
+    def peek(self) -> Line | Run | None:
+        if self._next is None:
+            self._next = next(self._items, None)
+        return self._next
+
+    def take(self) -> Line | Run | None:
+        item = self.peek()
+        self._next = None
+        return item
+
+
+def _keyword(text: str) -> str:
+    head = text.split(None, 1)
+    return head[0].upper() if head else ""
+
+
+class _Parser:
+    def __init__(self, source: Source) -> None:
+        self.source = source
+        self.stream = _Stream(source)
+
+    # -- diagnostics ----------------------------------------------------------------------------
+    def error(self, message: str, line: int | None) -> FormatError:
+        return FormatError(message, self.source.path, line)
+
+    def warn(self, message: str, line: int | None) -> None:
+        where = f"{self.source.path.name}:{line}: " if line is not None else ""
+        warnings.warn(f"{where}{message}", GocadWarning, stacklevel=6)
+
+    # -- objects --------------------------------------------------------------------------------
+    def parse_all(self) -> list[GocadObject]:
+        objects: list[GocadObject] = []
+        while True:
+            item = self.stream.take()
+            if item is None:
+                break
+            if isinstance(item, Run):
+                raise self.error(
+                    f"{item.keyword} line outside an object (expected 'GOCAD <type>')", item.first
+                )
+            if _keyword(item.text) != "GOCAD":
+                raise self.error(
+                    f"expected 'GOCAD <type>' to start an object, found {item.text[:40]!r}",
+                    item.number,
+                )
+            parsed = self.parse_object(item)
+            if parsed is not None:
+                objects.append(parsed)
+        if not objects:
+            raise self.error("no GOCAD object with a known type in the file", None)
+        return objects
+
+    def parse_object(self, start: Line) -> GocadObject | None:
+        tokens = start.text.split()
+        if len(tokens) < 2:
+            raise self.error("'GOCAD' without an object type", start.number)
+        kind = KNOWN_TYPES.get(tokens[1].lower())
+        if kind is None:
+            self.warn(f"skipping GOCAD {tokens[1]} object (no reader for this type)", start.number)
+            self._skip_object()
+            return None
+        obj = GocadObject(kind, tokens[2] if len(tokens) > 2 else "1", start.number)
+        if kind in _CELL_WIDTH or kind in ("VSet",):
+            self._parse_body(obj)
+        else:
+            self._parse_group(obj)
+        return obj
+
+    def _skip_object(self) -> None:
+        while True:
+            item = self.stream.peek()
+            if item is None:
+                return
+            if isinstance(item, Line):
+                keyword = _keyword(item.text)
+                if keyword == "GOCAD":
+                    self.warn("object without END before the next 'GOCAD' line", item.number)
+                    return
+                self.stream.take()
+                if keyword == "END":
+                    return
+            else:
+                self.stream.take()
+
+    # -- shared header parts --------------------------------------------------------------------
+    def _header_block(self, obj: GocadObject, line: Line) -> None:
+        rest = line.text.split("{", 1)[1] if "{" in line.text else ""
+        pending = [(line.number, rest)] if rest.strip() else []
+        closed = "}" in rest
+        if closed:
+            pending = [(line.number, rest.split("}", 1)[0])]
+        while not closed:
+            item = self.stream.peek()
+            if item is None or isinstance(item, Run):
+                self.warn("HEADER is not closed with '}'", line.number)
+                break
+            text = item.text
+            if ":" not in text and "}" not in text and _keyword(text) in _BODY_START:
+                self.warn("HEADER is not closed with '}'", line.number)
+                break
+            self.stream.take()
+            if "}" in text:
+                text = text.split("}", 1)[0]
+                closed = True
+            if text.strip():
+                pending.append((item.number, text))
+        for number, text in pending:
+            self._header_entry(obj, text, number)
+
+    def _header_entry(self, obj: GocadObject, text: str, number: int) -> None:
+        text = text.strip()
+        if not text:
+            return
+        if ":" not in text:
+            if obj.header and _NUMBERS_ONLY.fullmatch(text):  # a wrapped list of numbers
+                key, value = obj.header[-1]
+                obj.header[-1] = (key, f"{value}\n{text}")
+                self.warn(f"header value of {key!r} continues on this line", number)
+            else:
+                self.warn(f"header line {text[:40]!r} has no 'key:value'; ignored", number)
+            return
+        key, value = text.split(":", 1)
+        obj.header.append((key.strip(), value.strip()))
+
+    def _class_header(self, obj: GocadObject, line: Line) -> None:
+        head = line.text[len("PROPERTY_CLASS_HEADER") :]
+        name, _, rest = head.partition("{")
+        name = name.strip().strip('"').strip() if name.strip() else ""
+        entries: dict[str, str] = {}
+        closed = "}" in rest
+        body = [rest.split("}", 1)[0]] if rest.strip() else []
+        while not closed:
+            item = self.stream.peek()
+            if item is None or isinstance(item, Run):
+                self.warn(f"PROPERTY_CLASS_HEADER {name} is not closed with '}}'", line.number)
+                break
+            text = item.text
+            if ":" not in text and "}" not in text and _keyword(text) in _BODY_START:
+                self.warn(f"PROPERTY_CLASS_HEADER {name} is not closed with '}}'", line.number)
+                break
+            self.stream.take()
+            if "}" in text:
+                text = text.split("}", 1)[0]
+                closed = True
+            body.append(text)
+        for text in body:
+            if ":" in text:
+                key, value = text.split(":", 1)
+                entries[key.strip()] = value.strip()
+        obj.class_headers[name] = entries
+
+    def _crs_block(self, obj: GocadObject, line: Line) -> None:
+        crs: dict[str, Any] = {}
+        while True:
+            item = self.stream.peek()
+            if item is None or isinstance(item, Run):
+                self.warn("coordinate-system block is not closed", line.number)
+                break
+            keyword = _keyword(item.text)
+            if keyword in _BODY_START and keyword not in _CRS_KEYS:
+                self.warn("coordinate-system block is not closed", line.number)
+                break
+            self.stream.take()
+            if keyword == "END_ORIGINAL_COORDINATE_SYSTEM":
+                break
+            value = item.text[len(keyword) :].strip()
+            if keyword in ("AXIS_NAME", "AXIS_UNIT"):
+                parts = split_tokens(value)
+                if len(parts) != 3:
+                    self.warn(
+                        f"{keyword} needs 3 entries, found {len(parts)}; ignored", item.number
+                    )
+                    continue
+                crs[keyword] = parts
+            elif keyword == "ZPOSITIVE":
+                direction = value.split()[0].capitalize() if value.split() else ""
+                if direction not in ("Depth", "Elevation"):
+                    self.warn(f"ZPOSITIVE {value!r} is neither Depth nor Elevation", item.number)
+                    direction = "Elevation"
+                crs[keyword] = direction
+            elif keyword == "NAME":
+                crs[keyword] = _unquote(value)
+            else:  # PROJECTION, DATUM and others: kept verbatim
+                crs[keyword] = value
+        obj.crs = crs
+
+    def _common(self, obj: GocadObject, item: Line) -> bool:
+        """Handle a header-part line; False when it is not one."""
+        keyword = _keyword(item.text)
+        if keyword == "HEADER" or keyword.startswith("HEADER{"):
+            self._header_block(obj, item)
+        elif keyword == "GOCAD_ORIGINAL_COORDINATE_SYSTEM":
+            self._crs_block(obj, item)
+        elif keyword.startswith("PROPERTY_CLASS_HEADER"):
+            self._class_header(obj, item)
+        elif keyword in ("GEOLOGICAL_FEATURE", "GEOLOGICAL_TYPE"):
+            obj.geology[keyword] = _unquote(item.text[len(keyword) :].strip())
+        elif keyword == "STRATIGRAPHIC_POSITION":
+            obj.geology[keyword] = split_tokens(item.text)[1:]
+        else:
+            prefix = _CELL_PREFIX.get(obj.type, "")
+            if (
+                prefix
+                and keyword.startswith(prefix)
+                and keyword[len(prefix) :] in PROPERTY_KEYWORDS
+            ):
+                parse_property_line(
+                    obj.cell_header, keyword[len(prefix) :], item.text, item.number, self.warn
+                )
+            elif keyword in PROPERTY_KEYWORDS:
+                parse_property_line(obj.point_header, keyword, item.text, item.number, self.warn)
+            else:
+                return False
+        return True
+
+    # -- element bodies -------------------------------------------------------------------------
+    def _parse_body(self, obj: GocadObject) -> None:
+        vertices: VertexTable | None = None
+        cells: CellTable | None = None
+        part = -1
+        model_state: dict[str, Any] = {}
+        while True:
+            item = self.stream.peek()
+            if item is None:
+                self.warn(f"{obj.type} {obj.name!r} has no END", obj.line)
+                break
+            if isinstance(item, Line) and _keyword(item.text) == "GOCAD":
+                self.warn(f"{obj.type} {obj.name!r} has no END", obj.line)
+                break
+            self.stream.take()
+            if isinstance(item, Run):
+                if vertices is None:
+                    vertices, cells = self._tables(obj)
+                part = self._run(obj, item, vertices, cells, part)
+                continue
+            keyword = _keyword(item.text)
+            if keyword == "END":
+                break
+            if obj.type == "Model3d":
+                if not self._common(obj, item):
+                    self._model3d_line(obj, item, model_state)
+                continue
+            if vertices is None and not self._common(obj, item):
+                vertices, cells = self._tables(obj)
+            if vertices is None:
+                continue
+            if self._common(obj, item):
+                self.warn(f"{keyword} after the object's data lines", item.number)
+                continue
+            part = self._element_line(obj, item, keyword, vertices, cells, part, model_state)
+        if obj.type == "Model3d":
+            self._finish_model3d(obj, model_state)
+            return
+        if vertices is None:
+            vertices, cells = self._tables(obj)
+        obj.vertices = vertices.finish(self.error)
+        obj.cells = cells.finish() if cells is not None else None
+
+    def _tables(self, obj: GocadObject) -> tuple[VertexTable, CellTable | None]:
+        width = _CELL_WIDTH.get(obj.type)
+        cells = CellTable(width, obj.cell_header.n_values) if width else None
+        return VertexTable(obj.point_header.n_values), cells
+
+    def _new_part(self, obj: GocadObject, name: str, vertices: VertexTable) -> int:
+        obj.part_names.append(name)
+        obj.part_vertex_starts.append(vertices.count)
+        return len(obj.part_names) - 1
+
+    def _ensure_part(self, obj: GocadObject, part: int, vertices: VertexTable, line: int) -> int:
+        if part >= 0 or obj.type == "VSet":
+            return part
+        if obj.type in ("TSurf", "PLine"):
+            missing = "TFACE" if obj.type == "TSurf" else "ILINE"
+            self.warn(f"data before any {missing}: starting one", line)
+        return self._new_part(obj, "", vertices)
+
+    def _run(
+        self, obj: GocadObject, run: Run, vertices: VertexTable, cells: CellTable | None, part: int
+    ) -> int:
+        if run.keyword in ("VRTX", "PVRTX"):
+            part = self._ensure_part(obj, part, vertices, run.first)
+            width = 4 + (obj.point_header.n_values if run.keyword == "PVRTX" else 0)
+            try:
+                if run.count < 2:
+                    raise BulkParseError
+                block = parse_run(self.source, run, integer=False)
+                if block.shape[1] != width:
+                    raise BulkParseError
+            except BulkParseError:
+                self._run_lines(obj, run, vertices, cells, part)
+                return part
+            block = block.astype(np.float64, copy=False)
+            ids = check_finite_ids(self.error, block, run.first, run.keyword)
+            values = block[:, 4:] if run.keyword == "PVRTX" else self._no_values(obj, run.count)
+            vertices.add_block(ids, np.ascontiguousarray(block[:, 1:4]), values, run.first)
+            return part
+        expected = _CELL_KEYWORD.get(obj.type)
+        if cells is None or run.keyword != expected:
+            if obj.type in ("TSolid", "LightTSolid") and run.keyword == "TRGL":
+                self._run_lines(obj, run, vertices, cells, part)
+                return part
+            raise self.error(f"{run.keyword} lines are not allowed in a {obj.type}", run.first)
+        part = self._ensure_part(obj, part, vertices, run.first)
+        width = cells.width + cells.n_values
+        try:
+            if run.count < 2:
+                raise BulkParseError
+            block = parse_run(self.source, run, integer=not cells.n_values)
+            if block.shape[1] != width:
+                raise BulkParseError
+            ids = block[:, : cells.width]
+            if ids.dtype != np.int64:
+                if (ids != np.floor(ids)).any() or (np.abs(ids) > 2**53).any():
+                    raise BulkParseError
+                ids = ids.astype(np.int64)
+        except BulkParseError:
+            self._run_lines(obj, run, vertices, cells, part)
+            return part
+        cells.add_block(
+            np.ascontiguousarray(ids),
+            np.ascontiguousarray(block[:, cells.width :], dtype=np.float64),
+            part,
+            run.first,
+        )
+        return part
+
+    def _no_values(self, obj: GocadObject, n: int) -> Any:
+        return np.full((n, obj.point_header.n_values), np.nan)
+
+    def _run_lines(
+        self, obj: GocadObject, run: Run, vertices: VertexTable, cells: CellTable | None, part: int
+    ) -> None:
+        model_state: dict[str, Any] = {}
+        for index in range(run.count):
+            number = run.first + index
+            text = self.source.text(number - 1).strip()
+            self._element_line(
+                obj, Line(number, text), run.keyword, vertices, cells, part, model_state
+            )
+
+    def _element_line(
+        self,
+        obj: GocadObject,
+        item: Line,
+        keyword: str,
+        vertices: VertexTable,
+        cells: CellTable | None,
+        part: int,
+        model_state: dict[str, Any],
+    ) -> int:
+        tokens = item.text.split()
+        number = item.number
+        n_values = obj.point_header.n_values
+        try:
+            if keyword in ("VRTX", "PVRTX"):
+                part = self._ensure_part(obj, part, vertices, number)
+                flag, tokens = _strip_flags(tokens)
+                count = 5 + (n_values if keyword == "PVRTX" else 0)
+                if len(tokens) < count:
+                    raise self.error(
+                        f"{keyword} needs {count - 1} numbers, found {len(tokens) - 1}", number
+                    )
+                if len(tokens) > count:
+                    self.warn(
+                        f"{keyword} has {len(tokens) - count} extra value(s); ignored", number
+                    )
+                xyz = (parse_float(tokens[2]), parse_float(tokens[3]), parse_float(tokens[4]))
+                values = [parse_float(t) for t in tokens[5:count]] if keyword == "PVRTX" else None
+                if values is None and n_values:
+                    values = [np.nan] * n_values
+                vertices.add(parse_int(tokens[1]), xyz, None, values, flag, number)
+            elif keyword in ("ATOM", "PATOM", "SHAREDVRTX", "SHAREDPVRTX"):
+                part = self._ensure_part(obj, part, vertices, number)
+                flag, tokens = _strip_flags(tokens)
+                with_values = keyword in ("PATOM", "SHAREDPVRTX")
+                if len(tokens) < 3:
+                    raise self.error(f"{keyword} needs a new id and the id it refers to", number)
+                values = None
+                if with_values and n_values:
+                    if len(tokens) < 3 + n_values:
+                        raise self.error(
+                            f"{keyword} needs {n_values} property values, found {len(tokens) - 3}",
+                            number,
+                        )
+                    values = [parse_float(t) for t in tokens[3 : 3 + n_values]]
+                vertices.add(parse_int(tokens[1]), None, parse_int(tokens[2]), values, flag, number)
+            elif keyword in _PART_KEYWORDS:
+                name = item.text[len(keyword) :].strip()
+                if keyword == "SUBVSET" or obj.type in ("TSurf", "PLine", "TSolid", "LightTSolid"):
+                    if obj.type in ("TSolid", "LightTSolid") and model_state.get("in_model"):
+                        self._tsolid_model_line(obj, item, keyword, model_state)
+                    else:
+                        part = self._new_part(obj, _unquote(name), vertices)
+                else:
+                    self.warn(f"{keyword} is not used in a {obj.type}; ignored", number)
+            elif cells is not None and keyword == _CELL_KEYWORD.get(obj.type):
+                part = self._ensure_part(obj, part, vertices, number)
+                width, n_cell = cells.width, cells.n_values
+                if len(tokens) < 1 + width + n_cell:
+                    raise self.error(
+                        f"{keyword} needs {width} vertex ids"
+                        + (f" and {n_cell} values" if n_cell else "")
+                        + f", found {len(tokens) - 1} entries",
+                        number,
+                    )
+                if len(tokens) > 1 + width + n_cell:
+                    self.warn(f"{keyword} has extra entries; ignored", number)
+                ids = [parse_int(t) for t in tokens[1 : 1 + width]]
+                values = [parse_float(t) for t in tokens[1 + width : 1 + width + n_cell]]
+                cells.add(ids, values, part, number)
+            elif keyword == "# CTETRA" or (keyword == "#" and item.text.startswith("# CTETRA")):
+                if cells is None or cells.count == 0:
+                    raise self.error("'# CTETRA' before any TETRA", number)
+                parts = tokens[2:]
+                if obj.ctetra and obj.ctetra[-1][0] == cells.count - 1:
+                    self.warn("a second '# CTETRA' line for one TETRA replaces the first", number)
+                    obj.ctetra.pop()
+                obj.ctetra.append((cells.count - 1, parts[0] if parts else "", parts[1:5], number))
+            elif keyword == "BSTONE":
+                if len(tokens) < 2:
+                    raise self.error("BSTONE needs a vertex id", number)
+                obj.bstones.append((parse_int(tokens[1]), number))
+            elif keyword == "BORDER":
+                if len(tokens) < 4:
+                    raise self.error("BORDER needs an id and two vertex ids", number)
+                obj.borders.append(
+                    (parse_int(tokens[1]), parse_int(tokens[2]), parse_int(tokens[3]), number)
+                )
+            elif keyword in _SKIP_BLOCKS:
+                self._skip_block(keyword, number)
+            elif obj.type in ("TSolid", "LightTSolid"):
+                self._tsolid_model_line(obj, item, keyword, model_state)
+            else:
+                self.warn(f"unknown keyword {keyword!r} in a {obj.type}; line kept", number)
+                obj.extra_lines.append(item.text)
+        except ValueError as exc:
+            if isinstance(exc, FormatError):
+                raise
+            raise self.error(f"{keyword}: {exc}", number) from None
+        return part
+
+    def _skip_block(self, keyword: str, number: int) -> None:
+        end = _SKIP_BLOCKS[keyword]
+        self.warn(f"skipping {keyword} block", number)
+        while True:
+            item = self.stream.take()
+            if item is None:
+                raise self.error(f"{keyword} is not closed by {end}", number)
+            if isinstance(item, Line) and _keyword(item.text) == end:
+                return
+
+    # -- TSolid model section -------------------------------------------------------------------
+    def _tsolid_model_line(
+        self, obj: GocadObject, item: Line, keyword: str, state: dict[str, Any]
+    ) -> None:
+        model = obj.model
+        tokens = split_tokens(item.text)
+        if keyword == "MODEL":
+            state["in_model"] = True
+            model.setdefault("surfaces", [])
+            return
+        if keyword == "SURFACE":
+            model.setdefault("surfaces", []).append(
+                {"name": item.text[len(keyword) :].strip().strip('"'), "tfaces": []}
+            )
+        elif keyword == "TFACE":
+            surfaces = model.setdefault("surfaces", [])
+            if not surfaces:
+                raise self.error("TFACE before any SURFACE in the MODEL section", item.number)
+            tface_id = parse_int(tokens[1]) if len(tokens) > 1 else len(model.get("tfaces", [])) + 1
+            surfaces[-1]["tfaces"].append({"id": tface_id, "key": None, "triangles": []})
+        elif keyword == "KEYVERTICES":
+            current = self._current_tface(model, item)
+            if len(tokens) < 4:
+                raise self.error("KEYVERTICES needs 3 vertex ids", item.number)
+            current["key"] = ([parse_int(t) for t in tokens[1:4]], item.number)
+        elif keyword == "TRGL":
+            current = self._current_tface(model, item)
+            if len(tokens) < 4:
+                raise self.error("TRGL needs 3 vertex ids", item.number)
+            current["triangles"].append(([parse_int(t) for t in tokens[1:4]], item.number))
+        elif keyword == "MODEL_REGION":
+            if len(tokens) < 3:
+                raise self.error("MODEL_REGION needs a name and a signed TFACE id", item.number)
+            sign_text = tokens[-1]
+            model.setdefault("regions", []).append([" ".join(tokens[1:-1]), parse_int(sign_text)])
+        else:
+            self.warn(f"unknown keyword {keyword!r} in a {obj.type}; line kept", item.number)
+            obj.extra_lines.append(item.text)
+
+    def _current_tface(self, model: dict[str, Any], item: Line) -> dict[str, Any]:
+        surfaces = model.get("surfaces") or []
+        if not surfaces or not surfaces[-1]["tfaces"]:
+            raise self.error(f"{_keyword(item.text)} before any TFACE of the MODEL", item.number)
+        tface: dict[str, Any] = surfaces[-1]["tfaces"][-1]
+        return tface
+
+    # -- Model3d header -------------------------------------------------------------------------
+    def _model3d_line(self, obj: GocadObject, item: Line, state: dict[str, Any]) -> None:
+        keyword = _keyword(item.text)
+        model = obj.model
+        text = item.text
+        if keyword == "TSURF":
+            name = _unquote(text[len(keyword) :].strip())
+            if name in model.setdefault("tsurfs", []):
+                self.warn(f"TSURF {name!r} is listed twice", item.number)
+            else:
+                model["tsurfs"].append(name)
+            state.pop("list", None)
+            return
+        if keyword == "TFACE":
+            tokens = text.split(None, 3)
+            if len(tokens) < 4:
+                raise self.error(
+                    "TFACE needs an id, a geological type and a TSurf name", item.number
+                )
+            entry = {
+                "id": parse_int(tokens[1]),
+                "type": tokens[2],
+                "tsurf": _unquote(tokens[3].strip()),
+                "key": [],
+                "line": item.number,
+            }
+            model.setdefault("tfaces", []).append(entry)
+            state["key_for"] = entry
+            state.pop("list", None)
+            return
+        if keyword in ("REGION", "SURFACE", "LAYER", "FAULT_BLOCK", "FAULT", "BOUNDARY", "UNIT"):
+            tokens = text.split(None, 2)
+            if keyword == "REGION":
+                if len(tokens) < 3:
+                    raise self.error("REGION needs an id and a name", item.number)
+                entry = {
+                    "id": parse_int(tokens[1]),
+                    "name": _unquote(tokens[2].strip()),
+                    "items": [],
+                    "line": item.number,
+                }
+            else:
+                entry = {
+                    "name": _unquote(text[len(keyword) :].strip()),
+                    "items": [],
+                    "line": item.number,
+                }
+            model.setdefault("lists", []).append((keyword, entry))
+            state["list"] = entry
+            state.pop("key_for", None)
+            return
+        numbers = text.split()
+        key_for = state.get("key_for")
+        if key_for is not None and len(key_for["key"]) < 3:
+            try:
+                point = [parse_float(t) for t in numbers]
+            except ValueError as exc:
+                raise self.error(f"key triangle: {exc}", item.number) from None
+            if len(point) != 3:
+                raise self.error("a key-triangle line needs 3 coordinates", item.number)
+            key_for["key"].append(point)
+            return
+        current = state.get("list")
+        if current is not None and not current.get("closed"):
+            for token in numbers:
+                try:
+                    value = parse_int(token)
+                except ValueError as exc:
+                    raise self.error(
+                        f"{exc} in the list of {current['name']!r}", item.number
+                    ) from None
+                if value == 0:
+                    current["closed"] = True
+                    break
+                current["items"].append(value)
+            return
+        self.warn(f"unknown line in the Model3d header: {text[:40]!r}; kept", item.number)
+        obj.extra_lines.append(text)
+
+    def _finish_model3d(self, obj: GocadObject, state: dict[str, Any]) -> None:
+        for entry in obj.model.get("tfaces", []):
+            if len(entry["key"]) != 3:
+                raise self.error(
+                    f"TFACE {entry['id']} needs a key triangle of 3 coordinate lines", entry["line"]
+                )
+        for keyword, entry in obj.model.get("lists", []):
+            if not entry.pop("closed", False):
+                self.warn(f"{keyword} {entry['name']!r} list does not end with 0", entry["line"])
+
+    # -- groups ---------------------------------------------------------------------------------
+    def _parse_group(self, obj: GocadObject) -> None:
+        in_members = False
+        while True:
+            item = self.stream.peek()
+            if item is None:
+                self.warn(f"{obj.type} {obj.name!r} has no END", obj.line)
+                return
+            if isinstance(item, Run):
+                raise self.error(f"{item.keyword} lines directly inside a group", item.first)
+            keyword = _keyword(item.text)
+            if keyword == "GOCAD":
+                if not in_members:
+                    self.warn("group member outside BEGIN_MEMBERS", item.number)
+                self.stream.take()
+                member = self.parse_object(item)
+                if member is not None:
+                    obj.members.append(member)
+                continue
+            self.stream.take()
+            if keyword == "BEGIN_MEMBERS":
+                in_members = True
+            elif keyword == "END_MEMBERS":
+                in_members = False
+            elif keyword == "END":
+                return
+            elif keyword == "TYPE":
+                obj.model["member_type"] = item.text[len(keyword) :].strip()
+            elif not self._common(obj, item):
+                self.warn(f"unknown keyword {keyword!r} in a group; line kept", item.number)
+                obj.extra_lines.append(item.text)
+
+
+_CRS_KEYS = {
+    "NAME",
+    "PROJECTION",
+    "DATUM",
+    "AXIS_NAME",
+    "AXIS_UNIT",
+    "ZPOSITIVE",
+    "END_ORIGINAL_COORDINATE_SYSTEM",
+}
+_BODY_START = {
+    "GOCAD",
+    "END",
+    "GOCAD_ORIGINAL_COORDINATE_SYSTEM",
+    "GEOLOGICAL_FEATURE",
+    "GEOLOGICAL_TYPE",
+    "STRATIGRAPHIC_POSITION",
+    "PROPERTY_CLASS_HEADER",
+    "TFACE",
+    "3DFACE",
+    "ILINE",
+    "TVOLUME",
+    "ATOM",
+    "PATOM",
+    "TSURF",
+    "REGION",
+    "MODEL",
+    "BEGIN_MEMBERS",
+    *PROPERTY_KEYWORDS,
+}
+
+
+_NUMBERS_ONLY = re.compile(r"[-+0-9.eE\s]+")
+
+
+def _unquote(text: str) -> str:
+    if len(text) >= 2 and text[0] == '"' and text.endswith('"'):
+        return text[1:-1]
+    return text
+
+
+def _strip_flags(tokens: list[str]) -> tuple[int, list[str]]:
+    flag = 0
+    while tokens and tokens[-1].upper() in FLAG_NAMES:
+        flag = FLAG_NAMES[tokens[-1].upper()]
+        tokens = tokens[:-1]
+    return flag, tokens
+
+
+def parse_source(source: Source) -> list[GocadObject]:
+    """Every object (with known type) of a GOCAD file, in file order."""
+    return _Parser(source).parse_all()

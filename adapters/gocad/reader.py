@@ -1,0 +1,534 @@
+"""Turn parsed GOCAD objects into a geobrep :class:`~geobrep.scene.Scene`.
+
+* TSurf → :class:`Surface` with one patch per TFACE; PLine → :class:`PolyLine` with one part per
+  ILINE (split where its SEGs do not chain); VSet → :class:`PointSet`; TSolid / LightTSolid →
+  :class:`TetMesh` with one region per TVOLUME (plus one :class:`Surface` per SURFACE of its
+  MODEL section); Model3d → its member TSurfs, ``scene.topology`` (one patch per TFACE) and a
+  :class:`Block` per REGION; groups → :class:`~geobrep.scene.Group` s.
+* ``ZPOSITIVE Depth`` negates z (triangle winding is kept); the scene's CRS records it.
+* Everything else the file says is kept in ``metadata["gocad"]`` so that a writer can restore it.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep.adapters.gocad.headers import PropertyHeader, color_from_text
+from geobrep.adapters.gocad.lexer import Source
+from geobrep.adapters.gocad.model3d import attach_model3d
+from geobrep.adapters.gocad.objects import gocad_section
+from geobrep.adapters.gocad.options import GocadOptions
+from geobrep.adapters.gocad.parser import GROUP_TYPES, GocadObject, GocadWarning, parse_source
+from geobrep.crs import CRS
+from geobrep.entities import Entity, PointSet, PolyLine, Surface, TetMesh
+from geobrep.errors import EntityValidationError, FormatError, TopologyError
+from geobrep.properties import Property
+from geobrep.scene import Group, Scene
+
+__all__ = ["FLAG_PROPERTY", "GocadReadOptions", "crs_from_block", "read_gocad"]
+
+#: Point property holding per-vertex GOCAD flags (1 = CNXYZ, 2 = XYZ) when a file has any.
+FLAG_PROPERTY = "gocad_vertex_flag"
+#: Cell property of a TSolid holding its ``# CTETRA`` face codes (0: none, ±(k+1): surface k).
+CTETRA_PROPERTY = "gocad_ctetra_faces"
+#: Point property with the file's vertex ids (reader option ``vertex_ids=True``).
+VERTEX_ID_PROPERTY = "gocad_vertex_id"
+
+_COLOR_KEYS = ("*solid*color", "*line*color", "*atoms*color", "color")
+_KIND_OF_TYPE = {
+    "top": "horizon",
+    "none": "horizon",
+    "topographic": "horizon",
+    "unconformity": "unconformity",
+    "boundary": "boundary",
+    "lease": "boundary",
+    "intrusive": "intrusion",
+}
+
+
+GocadReadOptions = GocadOptions
+
+
+def kind_of(geological_type: str | None) -> str | None:
+    """geobrep ``kind`` for a GOCAD GEOLOGICAL_TYPE (``*fault`` → ``fault``, ``top`` → horizon)."""
+    if geological_type is None:
+        return None
+    lowered = geological_type.lower()
+    if "fault" in lowered:
+        return "fault"
+    return _KIND_OF_TYPE.get(lowered, lowered)
+
+
+def crs_from_block(block: dict[str, Any]) -> CRS:
+    """A :class:`CRS` from a parsed ``GOCAD_ORIGINAL_COORDINATE_SYSTEM`` block."""
+    extra = {
+        key.lower(): value
+        for key, value in block.items()
+        if key not in ("NAME", "AXIS_NAME", "AXIS_UNIT", "ZPOSITIVE")
+    }
+    return CRS(
+        name=block.get("NAME"),
+        axis_names=tuple(block.get("AXIS_NAME", ("X", "Y", "Z"))),
+        axis_units=tuple(block.get("AXIS_UNIT", ("m", "m", "m"))),
+        z_positive="down" if block.get("ZPOSITIVE") == "Depth" else "up",
+        metadata={"gocad": extra} if extra else {},
+    )
+
+
+def _properties(
+    header: PropertyHeader,
+    values: NDArray[np.float64],
+    class_headers: dict[str, dict[str, str]],
+    where: str,
+    error: Any,
+) -> dict[str, Property]:
+    out: dict[str, Property] = {}
+    column = 0
+    for spec in header.specs:
+        block = values[:, column : column + spec.esize]
+        column += spec.esize
+        data = block[:, 0] if spec.esize == 1 else block
+        name = spec.name
+        if name in out or name in (FLAG_PROPERTY, CTETRA_PROPERTY, VERTEX_ID_PROPERTY):
+            renamed = f"{name}_{len(out)}"
+            warnings.warn(f"{where}: property {name!r} renamed {renamed!r}", GocadWarning, 3)
+            name = renamed
+        metadata: dict[str, Any] = {"gocad": spec.metadata()} if spec.metadata() else {}
+        out[name] = Property(
+            values=np.ascontiguousarray(data),
+            unit=spec.unit,
+            no_data_value=spec.no_data,
+            metadata=metadata,
+        )
+    return out
+
+
+class _Builder:
+    def __init__(self, source: Source, options: GocadReadOptions) -> None:
+        self.source = source
+        self.options = options
+        self.path = source.path
+        self.entities: list[Entity] = []
+        self.scene_crs: dict[str, Any] | None = None
+        self.surface_of_object: dict[int, int] = {}
+
+    def error(self, message: str, line: int | None) -> FormatError:
+        return FormatError(message, self.path, line)
+
+    def warn(self, message: str, line: int | None = None) -> None:
+        where = f"{self.path.name}:{line}: " if line is not None else f"{self.path.name}: "
+        warnings.warn(where + message, GocadWarning, stacklevel=4)
+
+    def next_id(self) -> int:
+        return len(self.entities)
+
+    # -- the whole file -----------------------------------------------------------------------
+    def build(self, objects: list[GocadObject]) -> Scene:
+        self.scene_crs = _first_crs(objects)
+        groups: list[Group] = []
+        models: list[GocadObject] = []
+        for obj in objects:
+            group = self.add_object(obj, None, models)
+            if group is not None:
+                groups.append(group)
+        crs = crs_from_block(self.scene_crs) if self.scene_crs is not None else None
+        surfaces = [e for e in self.entities if isinstance(e, Surface)]
+        topology = None
+        blocks: list[Entity] = []
+        model_groups: list[Group] = []
+        name = objects[0].name
+        metadata: dict[str, Any] = {}
+        if models:
+            if len(models) > 1:
+                self.warn(
+                    f"{len(models)} Model3d objects: only the first with TFACEs defines "
+                    "the topology"
+                )
+            model = next((m for m in models if m.model.get("tfaces")), models[0])
+            name = model.name
+            self._kinds_from_model(model)
+            surfaces = [e for e in self.entities if isinstance(e, Surface)]
+            topology, blocks, model_groups, metadata = attach_model3d(
+                model, surfaces, self.next_id(), self._z_sign(model), self.options, self
+            )
+        elif any(gocad_section(e.metadata).get("borders") for e in surfaces):
+            from geobrep.adapters.gocad.model3d import border_topology
+
+            topology = border_topology(surfaces, self.options)
+        try:
+            return Scene(
+                entities=[*self.entities, *blocks],
+                groups=[*groups, *model_groups],
+                crs=crs,
+                topology=topology if topology is not None else {},
+                name=name,
+                metadata=metadata,
+            )
+        except (EntityValidationError, TopologyError) as exc:
+            raise self.error(f"the file's objects do not form a valid scene: {exc}", None) from exc
+
+    def _kinds_from_model(self, model: GocadObject) -> None:
+        """Surfaces without a GEOLOGICAL_TYPE take the type of their header TFACEs."""
+        types: dict[str, str] = {}
+        for entry in model.model.get("tfaces", []):
+            types.setdefault(entry["tsurf"], entry["type"])
+        for index, entity in enumerate(self.entities):
+            if not isinstance(entity, Surface) or entity.kind is not None:
+                continue
+            names = [entity.name]
+            for key, value in gocad_section(entity.metadata).get("header", []):
+                if key == "name_in_model_list":
+                    names.insert(0, str(value))
+            found = next((types[n] for n in names if n in types), None)
+            if found is not None:
+                self.entities[index] = entity.replace(kind=kind_of(found))
+
+    def add_object(
+        self, obj: GocadObject, parent_crs: dict[str, Any] | None, models: list[GocadObject]
+    ) -> Group | None:
+        if obj.crs is None and parent_crs is not None:
+            obj.crs = dict(parent_crs)
+            obj.model["inherited_crs"] = True
+        if obj.type in GROUP_TYPES:
+            start = self.next_id()
+            children = []
+            members: list[int] = []
+            for member in obj.members:
+                before = self.next_id()
+                child = self.add_object(member, obj.crs, models)
+                if child is not None:
+                    children.append(child)
+                members.extend(range(before, self.next_id()))
+            direct = [
+                m for m in members if not any(m in c.members for g in children for c in g.walk())
+            ]
+            return Group(
+                name=obj.name,
+                kind=obj.type,
+                members=tuple(direct),
+                children=tuple(children),
+                metadata={"gocad": self._object_metadata(obj, start)},
+            )
+        if obj.type == "Model3d":
+            models.append(obj)
+            return None
+        try:
+            self._add_entity(obj)
+        except EntityValidationError as exc:
+            raise self.error(f"{obj.type} {obj.name!r}: {exc}", obj.line) from exc
+        return None
+
+    def _z_sign(self, obj: GocadObject) -> float:
+        return -1.0 if (obj.crs or {}).get("ZPOSITIVE") == "Depth" else 1.0
+
+    def _object_metadata(self, obj: GocadObject, _: int = 0) -> dict[str, Any]:
+        meta: dict[str, Any] = {"type": obj.type, "version": obj.version}
+        meta["header"] = [[k, v] for k, v in obj.header]
+        if (
+            obj.crs is not None
+            and not obj.model.get("inherited_crs")
+            and (
+                self.scene_crs is None or crs_from_block(obj.crs) != crs_from_block(self.scene_crs)
+            )
+        ):
+            meta["crs"] = obj.crs
+        if obj.crs is None and self.scene_crs is not None:
+            meta["crs"] = None
+        if obj.geology:
+            meta["geology"] = obj.geology
+        if obj.class_headers:
+            meta["class_headers"] = obj.class_headers
+        if obj.extra_lines:
+            meta["extra_lines"] = obj.extra_lines
+        if "member_type" in obj.model:
+            meta["member_type"] = obj.model["member_type"]
+        return meta
+
+    def _common_fields(self, obj: GocadObject) -> dict[str, Any]:
+        metadata: dict[str, Any] = {"gocad": self._object_metadata(obj)}
+        for key in _COLOR_KEYS:
+            value = obj.header_value(key)
+            if value is not None:
+                color = color_from_text(value)
+                if color is not None:
+                    metadata["color"] = color
+                break
+        geo_type = obj.geology.get("GEOLOGICAL_TYPE")
+        return {"name": obj.name, "kind": kind_of(geo_type), "metadata": metadata}
+
+    # -- one object -----------------------------------------------------------------------------
+    def _add_entity(self, obj: GocadObject) -> None:
+        vertices = obj.vertices
+        assert vertices is not None
+        xyz = vertices.xyz
+        if self._z_sign(obj) < 0 and xyz.size:
+            xyz = xyz.copy()
+            xyz[:, 2] = -xyz[:, 2]
+        where = f"{self.path.name}:{obj.line}"
+        if not np.isfinite(xyz).all():
+            row = int(np.argmax(~np.isfinite(xyz).all(axis=1)))
+            raise self.error("vertex coordinates must be finite numbers", int(vertices.lines[row]))
+        point_data = _properties(
+            obj.point_header, vertices.values, obj.class_headers, where, self.error
+        )
+        if vertices.flags.any():
+            point_data[FLAG_PROPERTY] = Property(
+                values=vertices.flags.astype(np.int8),
+                description="GOCAD vertex flags",
+                metadata={"gocad": {"codes": {"1": "CNXYZ", "2": "XYZ"}}},
+            )
+        if self.options.vertex_ids:
+            point_data[VERTEX_ID_PROPERTY] = Property(
+                values=vertices.ids, description="vertex ids of the GOCAD file"
+            )
+        fields = self._common_fields(obj)
+        fields["id"] = self.next_id()
+        lookup = vertices.lookup
+        cells = obj.cells
+        if obj.type == "VSet":
+            if obj.part_vertex_starts:
+                fields["metadata"]["gocad"]["subvset_starts"] = list(obj.part_vertex_starts)
+            self.entities.append(PointSet(vertices=xyz, point_data=point_data, **fields))
+            return
+        assert cells is not None
+        ids, values, parts, lines = cells
+        keyword = {"TSurf": "TRGL", "PLine": "SEG"}.get(obj.type, "TETRA")
+        index = lookup.require(ids, lines, keyword, self.error)
+        cell_data = _properties(obj.cell_header, values, obj.class_headers, where, self.error)
+        names = tuple(name or str(i) for i, name in enumerate(obj.part_names))
+        if obj.type == "TSurf":
+            self._hints(obj, lookup, fields)
+            self.entities.append(
+                Surface(
+                    vertices=xyz,
+                    faces=index,
+                    patch_labels=parts,
+                    patch_names=names or ("0",),
+                    point_data=point_data,
+                    cell_data=cell_data,
+                    **fields,
+                )
+            )
+        elif obj.type == "PLine":
+            self.entities.append(
+                self._polyline(obj, xyz, index, parts, point_data, cell_data, fields)
+            )
+        else:
+            self._tsolid(obj, xyz, index, parts, names, point_data, cell_data, fields, lookup)
+
+    def _hints(self, obj: GocadObject, lookup: Any, fields: dict[str, Any]) -> None:
+        """BSTONE / BORDER lines as vertex indices in ``metadata["gocad"]``."""
+        gocad = fields["metadata"]["gocad"]
+        if obj.bstones:
+            ids = np.array([b[0] for b in obj.bstones], dtype=np.int64)
+            lines = np.array([b[1] for b in obj.bstones], dtype=np.int64)
+            gocad["bstones"] = lookup.require(ids[:, None], lines, "BSTONE", self.error)[
+                :, 0
+            ].tolist()
+        if obj.borders:
+            ids = np.array([[b[1], b[2]] for b in obj.borders], dtype=np.int64)
+            lines = np.array([b[3] for b in obj.borders], dtype=np.int64)
+            gocad["borders"] = lookup.require(ids, lines, "BORDER", self.error).tolist()
+
+    def _polyline(
+        self,
+        obj: GocadObject,
+        xyz: NDArray[np.float64],
+        segments: NDArray[np.int64],
+        parts: NDArray[np.int64],
+        point_data: dict[str, Property],
+        cell_data: dict[str, Property],
+        fields: dict[str, Any],
+    ) -> PolyLine:
+        n_seg = segments.shape[0]
+        if n_seg == 0:
+            indices = np.zeros(0, dtype=np.int64)
+            offsets = np.zeros(1, dtype=np.int64)
+            closed = np.zeros(0, dtype=bool)
+            chain_of_iline = np.zeros(len(obj.part_names), dtype=np.int64)
+        else:
+            a, b = segments[:, 0], segments[:, 1]
+            starts = np.ones(n_seg, dtype=bool)
+            starts[1:] = (parts[1:] != parts[:-1]) | (a[1:] != b[:-1])
+            chain = np.cumsum(starts) - 1
+            first = np.flatnonzero(starts)
+            last = np.append(first[1:] - 1, n_seg - 1)
+            n_chain = first.shape[0]
+            indices = np.empty(n_seg + n_chain, dtype=np.int64)
+            indices[np.arange(n_seg) + chain + 1] = b
+            indices[first + np.arange(n_chain)] = a[first]
+            lengths = last - first + 2
+            closed = (b[last] == a[first]) & (lengths >= 4)
+            keep = np.ones(indices.shape[0], dtype=bool)
+            keep[(last + np.arange(n_chain) + 1)[closed]] = False
+            indices = indices[keep]
+            lengths = lengths - closed
+            offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
+            chain_of_iline = np.bincount(parts[first], minlength=len(obj.part_names))
+        if len(chain_of_iline) and not (chain_of_iline == 1).all():
+            fields["metadata"]["gocad"]["iline_parts"] = chain_of_iline.tolist()
+        if obj.part_names and any(obj.part_names):
+            fields["metadata"]["gocad"]["iline_names"] = list(obj.part_names)
+        return PolyLine(
+            vertices=xyz,
+            indices=indices,
+            part_offsets=offsets,
+            closed=closed,
+            point_data=point_data,
+            cell_data=cell_data,
+            **fields,
+        )
+
+    def _tsolid(
+        self,
+        obj: GocadObject,
+        xyz: NDArray[np.float64],
+        tetra: NDArray[np.int64],
+        parts: NDArray[np.int64],
+        names: tuple[str, ...],
+        point_data: dict[str, Property],
+        cell_data: dict[str, Property],
+        fields: dict[str, Any],
+        lookup: Any,
+    ) -> None:
+        gocad = fields["metadata"]["gocad"]
+        if obj.ctetra:
+            codes, surfaces, regions = _ctetra_codes(obj, tetra.shape[0], self.error)
+            cell_data[CTETRA_PROPERTY] = Property(
+                values=codes,
+                description="GOCAD '# CTETRA' faces: 0 none, +k/-k side of surface k-1",
+                metadata={"gocad": {"surfaces": surfaces}},
+            )
+            named = np.array([names[p] if p < len(names) else "" for p in np.unique(parts)])
+            expected = dict(zip(np.unique(parts).tolist(), named.tolist(), strict=True))
+            mismatched = [r for r in regions if r[1] != expected.get(int(parts[r[0]]), r[1])]
+            if mismatched:
+                gocad["ctetra_regions"] = [[int(c), str(n)] for c, n in regions]
+                self.warn(f"# CTETRA regions differ from TVOLUME parts in {obj.name!r}", obj.line)
+        model = obj.model
+        if model.get("regions"):
+            gocad["model_regions"] = model["regions"]
+        tet_id = self.next_id()
+        self.entities.append(
+            TetMesh(
+                vertices=xyz,
+                cells=tetra,
+                region_labels=parts,
+                region_names=names or ("0",),
+                point_data=point_data,
+                cell_data=cell_data,
+                **fields,
+            )
+        )
+        for surface in model.get("surfaces", []):
+            self._tsolid_surface(obj, surface, xyz, lookup, tet_id)
+
+    def _tsolid_surface(
+        self,
+        obj: GocadObject,
+        surface: dict[str, Any],
+        xyz: NDArray[np.float64],
+        lookup: Any,
+        tet_id: int,
+    ) -> None:
+        rows: list[list[int]] = []
+        lines: list[int] = []
+        labels: list[int] = []
+        keys: list[Any] = []
+        for label, tface in enumerate(surface["tfaces"]):
+            for tri, line in tface["triangles"]:
+                rows.append(tri)
+                lines.append(line)
+                labels.append(label)
+            keys.append(tface["key"])
+        ids = np.asarray(rows, dtype=np.int64).reshape(-1, 3)
+        index = lookup.require(ids, np.asarray(lines, dtype=np.int64), "TRGL", self.error)
+        used, compact = np.unique(index, return_inverse=True)
+        key_faces: list[int | None] = []
+        for label, key in enumerate(keys):
+            if key is None:
+                tface = surface["tfaces"][label]["id"]
+                self.warn(f"TFACE {tface} of MODEL surface {surface['name']!r} has no KEYVERTICES")
+                key_faces.append(None)
+                continue
+            key_index = lookup.require(
+                np.asarray([key[0]], dtype=np.int64),
+                np.asarray([key[1]]),
+                "KEYVERTICES",
+                self.error,
+            )[0]
+            match = np.flatnonzero((index == key_index).all(axis=1) & (np.asarray(labels) == label))
+            if not match.size:
+                self.warn(
+                    f"KEYVERTICES of TFACE {surface['tfaces'][label]['id']} is no TRGL of it",
+                    key[1],
+                )
+            key_faces.append(int(match[0]) if match.size else None)
+        self.entities.append(
+            Surface(
+                id=self.next_id(),
+                name=surface["name"],
+                vertices=xyz[used],
+                faces=compact.reshape(-1, 3),
+                patch_labels=np.asarray(labels, dtype=np.int64),
+                patch_names=tuple(str(t["id"]) for t in surface["tfaces"]) or ("0",),
+                metadata={
+                    "gocad": {
+                        "type": "TSolid.SURFACE",
+                        "tsolid": tet_id,
+                        "tface_ids": [t["id"] for t in surface["tfaces"]],
+                        "tsolid_vertices": used.tolist(),
+                        "key_triangles": key_faces,
+                    }
+                },
+            )
+        )
+
+
+def _ctetra_codes(
+    obj: GocadObject, n_cells: int, error: Any
+) -> tuple[NDArray[np.int64], list[str], list[tuple[int, str]]]:
+    surfaces: list[str] = []
+    position: dict[str, int] = {}
+    codes = np.zeros((n_cells, 4), dtype=np.int64)
+    regions: list[tuple[int, str]] = []
+    for cell, region, faces, line in obj.ctetra:
+        regions.append((cell, region))
+        if len(faces) != 4:
+            raise error("'# CTETRA' needs a region and 4 face entries", line)
+        for k, entry in enumerate(faces):
+            if entry.lower() == "none":
+                continue
+            sign = -1 if entry.startswith("-") else 1
+            body = entry[1:] if entry[:1] in "+-" else entry
+            if body not in position:
+                position[body] = len(surfaces)
+                surfaces.append(body)
+            codes[cell, k] = sign * (position[body] + 1)
+    return codes, surfaces, regions
+
+
+def _first_crs(objects: list[GocadObject]) -> dict[str, Any] | None:
+    for obj in objects:
+        if obj.crs is not None:
+            return obj.crs
+        found = _first_crs(obj.members)
+        if found is not None:
+            return found
+    return None
+
+
+def read_gocad(path: Path, options: GocadReadOptions | None = None) -> Scene:
+    """Read any GOCAD ASCII file (.ts .pl .vs .so .ml .gp) into a scene.
+
+    >>> import geobrep  # doctest: +SKIP
+    >>> geobrep.read("modelA4.ml").topology.patches  # doctest: +SKIP
+    """
+    source = Source.read(Path(path))
+    objects = parse_source(source)
+    return _Builder(source, options or GocadReadOptions()).build(objects)

@@ -1,0 +1,291 @@
+"""Mesh formats through meshio: VTU, legacy VTK, OBJ, STL, OFF and Gmsh.
+
+VTU and legacy VTK keep a whole scene (points, lines, surfaces, tetrahedral meshes with names,
+ids, patch labels, properties, CRS and groups); the others keep what they can, and
+:func:`geobrep.capabilities.capability_losses` says what they cannot. Legacy VTK POLYDATA files
+(what ParaView writes for surfaces), which meshio cannot read, are read through pyvista when the
+``viz`` extra is installed.
+
+>>> import geobrep, tempfile, pathlib
+>>> scene = geobrep.datasets.faulted_layer_cake()
+>>> path = geobrep.write(scene, pathlib.Path(tempfile.mkdtemp()) / "cake.vtu")
+>>> [s.name for s in geobrep.read(path).surfaces][:2]
+['H1', 'H2']
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict
+
+from geobrep.adapters.meshio.bridge import (
+    layout_from_mesh,
+    mesh_from_layout,
+    read_mesh,
+    write_mesh,
+)
+from geobrep.adapters.meshio.header import (
+    embed_legacy_header,
+    embed_vtu_header,
+    read_legacy_header,
+)
+from geobrep.capabilities import restrict_scene
+from geobrep.cell_layout import (
+    ENTITY_ARRAY,
+    LAYOUT_TYPES,
+    header_applies,
+    layout_to_scene,
+    scene_to_layout,
+)
+from geobrep.errors import FormatError, MissingDependencyError
+from geobrep.hookspecs import hookimpl
+from geobrep.registry import FormatCapabilities, FormatRegistry, FormatSpec, NoOptions
+from geobrep.scene import Scene
+
+__all__ = [
+    "CAPABILITIES",
+    "LegacyVtkOptions",
+    "StlOptions",
+    "VtuOptions",
+    "geobrep_register_formats",
+]
+
+_FULL = FormatCapabilities(
+    entity_types=LAYOUT_TYPES,
+    point_data=True,
+    cell_data=True,
+    names=True,
+    ids=True,
+    crs=True,
+    multiple_entities=True,
+)
+_SURFACE_ONLY = FormatCapabilities(entity_types=frozenset({"Surface"}))
+
+#: What each meshio-backed format holds, by format name.
+CAPABILITIES: dict[str, FormatCapabilities] = {
+    "vtu": _FULL,
+    "vtk": _FULL,
+    "gmsh": FormatCapabilities(
+        entity_types=LAYOUT_TYPES, point_data=True, ids=True, multiple_entities=True
+    ),
+    "obj": _SURFACE_ONLY,
+    "stl": _SURFACE_ONLY,
+    "off": _SURFACE_ONLY,
+}
+
+
+class VtuOptions(BaseModel):
+    """Options of the ``vtu`` writer."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    compression: Literal["zlib", "lzma"] | None = None
+    """Compress the binary arrays (smaller files, slower)."""
+
+
+class LegacyVtkOptions(BaseModel):
+    """Options of the legacy ``vtk`` writer."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    binary: bool = True
+    """Big-endian binary arrays; False writes ASCII."""
+
+
+class StlOptions(BaseModel):
+    """Options of the ``stl`` writer."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    binary: bool = False
+    """Binary STL stores coordinates as float32 (UTM coordinates lose centimetres); the
+    default ASCII STL keeps them exactly."""
+
+
+def _read_vtu(path: Path, options: BaseModel) -> Scene:
+    mesh = read_mesh(path, "vtu")
+    return layout_to_scene(layout_from_mesh(mesh, path), path)
+
+
+def _write_vtu(scene: Scene, path: Path, options: VtuOptions) -> None:
+    layout = scene_to_layout(restrict_scene(scene, CAPABILITIES["vtu"]))
+    mesh = mesh_from_layout(layout, field_data=False)
+    write_mesh(mesh, path, "vtu", binary=True, compression=options.compression)
+    if layout.header is not None:
+        embed_vtu_header(path, layout.header)
+
+
+def _read_legacy(path: Path, options: BaseModel) -> Scene:
+    with path.open("rb") as stream:
+        head = stream.read(1024)
+    if b"POLYDATA" in head or b"STRUCTURED_GRID" in head.replace(b"UNSTRUCTURED_GRID", b""):
+        return _read_through_pyvista(path)
+    try:
+        mesh = read_mesh(path, "vtk")
+    except FormatError:
+        if _pyvista_available():  # VTK reads more of its own format than meshio does
+            return _read_through_pyvista(path)
+        raise
+    layout = layout_from_mesh(mesh, path)
+    header = read_legacy_header(path)
+    if header_applies(header, layout.cell_data):
+        layout.header = header
+    return layout_to_scene(layout, path)
+
+
+def _pyvista_available() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("pyvista") is not None
+
+
+def _read_through_pyvista(path: Path) -> Scene:
+    """Legacy POLYDATA and structured grids: meshio cannot read them, VTK can."""
+    try:
+        from geobrep.adapters.pyvista import read_vtk_dataset
+    except ImportError as exc:  # pragma: no cover - same distribution
+        raise FormatError("legacy POLYDATA needs the pyvista adapter", path) from exc
+    try:
+        import pyvista  # noqa: F401
+    except ImportError as exc:
+        raise MissingDependencyError(
+            "pyvista", "viz", f"reading legacy VTK POLYDATA ({path.name})"
+        ) from exc
+    return read_vtk_dataset(path, ".vtk")
+
+
+def _write_legacy(scene: Scene, path: Path, options: LegacyVtkOptions) -> None:
+    layout = scene_to_layout(restrict_scene(scene, CAPABILITIES["vtk"]))
+    mesh = mesh_from_layout(layout, field_data=False)
+    write_mesh(mesh, path, "vtk", binary=options.binary)
+    if layout.header is not None:
+        embed_legacy_header(path, layout.header, options.binary)
+
+
+def _reader(file_format: str):  # type: ignore[no-untyped-def]
+    def read(path: Path, options: BaseModel) -> Scene:
+        return layout_to_scene(layout_from_mesh(read_mesh(path, file_format), path), path)
+
+    return read
+
+
+def _surface_writer(file_format: str):  # type: ignore[no-untyped-def]
+    def write(scene: Scene, path: Path, options: BaseModel) -> None:
+        kept = restrict_scene(scene, CAPABILITIES[file_format])
+        if not kept.surfaces:
+            raise FormatError(f"{file_format.upper()} holds surfaces and the scene has none", path)
+        shapes = {s.faces.shape[1] for s in kept.surfaces}
+        if file_format in ("stl",) and shapes != {3}:
+            raise FormatError("STL holds triangles only; triangulate the quad surfaces", path)
+        layout = scene_to_layout(kept)
+        layout.point_data, layout.cell_data, layout.header = {}, {}, None
+        extra = {"binary": options.binary} if isinstance(options, StlOptions) else {}
+        write_mesh(mesh_from_layout(layout, field_data=False), path, file_format, **extra)
+
+    return write
+
+
+def _gmsh_write(scene: Scene, path: Path, options: BaseModel) -> None:
+    import numpy as np
+
+    layout = scene_to_layout(restrict_scene(scene, CAPABILITIES["gmsh"]))
+    mesh = mesh_from_layout(layout, field_data=False)
+    assert layout.header is not None
+    ids = [int(record["id"]) for record in layout.header["entities"]]  # one block per entity
+    entity = [
+        np.full(len(conn), ident, np.int32)
+        for ident, (_, conn) in zip(ids, layout.blocks, strict=True)
+    ]
+    # meshio reads Gmsh element data back misaligned with several cell blocks: keep tags only
+    mesh.cell_data = {"gmsh:physical": entity, "gmsh:geometrical": entity}
+    write_mesh(mesh, path, "gmsh22", binary=True)
+
+
+def _read_gmsh(path: Path, options: BaseModel) -> Scene:
+    mesh = read_mesh(path, "gmsh")
+    physical = mesh.cell_data.pop("gmsh:physical", None)
+    mesh.cell_data.pop("gmsh:geometrical", None)
+    mesh.point_data.pop("gmsh:dim_tags", None)
+    if physical is not None:
+        mesh.cell_data[ENTITY_ARRAY] = physical
+    return layout_to_scene(layout_from_mesh(mesh, path), path)
+
+
+def _sniff_legacy(head: bytes) -> bool:
+    return head.lstrip().startswith(b"# vtk DataFile")
+
+
+def _sniff_vtu(head: bytes) -> bool:
+    return b"<VTKFile" in head and b'type="UnstructuredGrid"' in head
+
+
+def _sniff_gmsh(head: bytes) -> bool:
+    return head.lstrip().startswith(b"$MeshFormat")
+
+
+def _sniff_off(head: bytes) -> bool:
+    return head.lstrip().startswith(b"OFF")
+
+
+def _sniff_stl(head: bytes) -> bool:
+    return head.lstrip().startswith(b"solid") and b"facet" in head
+
+
+@hookimpl
+def geobrep_register_formats(registry: FormatRegistry) -> None:
+    """Register ``vtu``, ``vtk``, ``gmsh``, ``obj``, ``stl`` and ``off``."""
+    registry.add(
+        FormatSpec(
+            name="vtu",
+            description="VTK XML unstructured grid (meshio): whole scenes, exact",
+            extensions=(".vtu",),
+            reader=_read_vtu,
+            writer=_write_vtu,
+            sniff=_sniff_vtu,
+            options=VtuOptions,
+            capabilities=CAPABILITIES["vtu"],
+        )
+    )
+    registry.add(
+        FormatSpec(
+            name="vtk",
+            description="legacy VTK (meshio; POLYDATA through pyvista): whole scenes, exact",
+            extensions=(".vtk",),
+            reader=_read_legacy,
+            writer=_write_legacy,
+            sniff=_sniff_legacy,
+            options=LegacyVtkOptions,
+            capabilities=CAPABILITIES["vtk"],
+        )
+    )
+    registry.add(
+        FormatSpec(
+            name="gmsh",
+            description="Gmsh 2.2 binary mesh (meshio): entity ids as physical tags",
+            extensions=(".msh",),
+            reader=_read_gmsh,
+            writer=_gmsh_write,
+            sniff=_sniff_gmsh,
+            options=NoOptions,
+            capabilities=CAPABILITIES["gmsh"],
+        )
+    )
+    for name, description, sniff, options in (
+        ("obj", "Wavefront OBJ (meshio): one surface", None, NoOptions),
+        ("stl", "STL (meshio): one triangulated surface", _sniff_stl, StlOptions),
+        ("off", "Geomview OFF (meshio): one surface", _sniff_off, NoOptions),
+    ):
+        registry.add(
+            FormatSpec(
+                name=name,
+                description=description,
+                extensions=(f".{name}",),
+                reader=_reader(name),
+                writer=_surface_writer(name),
+                sniff=sniff,
+                options=options,
+                capabilities=CAPABILITIES[name],
+            )
+        )

@@ -1,0 +1,92 @@
+"""Put geobrep's JSON header into VTK files meshio writes without field data.
+
+meshio's VTU and legacy VTK writers drop ``field_data``; VTK itself (and ParaView) read it.
+:func:`embed_vtu_header` adds a ``<FieldData>`` element at the end of a ``.vtu`` (in place, only
+the tail is rewritten); :func:`embed_legacy_header` adds a ``FIELD FieldData`` section after the
+``DATASET`` line of a legacy ``.vtk`` (as VTK's own writer does), and
+:func:`read_legacy_header` finds it again.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from geobrep.cell_layout import HEADER_ARRAY, decode_header, encode_header
+from geobrep.errors import FormatError
+
+__all__ = ["embed_legacy_header", "embed_vtu_header", "read_legacy_header"]
+
+_TAIL = 4096
+_LEGACY_HEAD = 1 << 22
+
+
+def embed_vtu_header(path: Path, header: dict[str, Any]) -> None:
+    """Append the header as UInt8 ``FieldData`` of the ``UnstructuredGrid`` element."""
+    data = encode_header(header)
+    values = " ".join(map(str, data.tolist()))
+    element = (
+        f'<FieldData>\n<DataArray type="UInt8" Name="{HEADER_ARRAY}" '
+        f'NumberOfTuples="{data.size}" format="ascii">\n{values}\n</DataArray>\n</FieldData>\n'
+    ).encode()
+    with path.open("r+b") as stream:
+        size = stream.seek(0, 2)
+        start = max(0, size - _TAIL)
+        stream.seek(start)
+        tail = stream.read()
+        where = tail.rfind(b"</UnstructuredGrid>")
+        if where < 0:
+            raise FormatError("meshio wrote no </UnstructuredGrid> element", path)
+        stream.seek(start + where)
+        stream.write(element + tail[where:])
+
+
+def embed_legacy_header(path: Path, header: dict[str, Any], binary: bool) -> None:
+    """Insert a ``FIELD FieldData`` section holding the header after the ``DATASET`` line."""
+    data = encode_header(header)
+    body = data.tobytes() if binary else " ".join(map(str, data.tolist())).encode()
+    section = (
+        f"FIELD FieldData 1\n{HEADER_ARRAY} 1 {data.size} vtktypeuint8\n".encode() + body + b"\n"
+    )
+    staged = path.with_name(path.name + ".body")
+    path.rename(staged)
+    try:
+        with staged.open("rb") as source, path.open("wb") as target:
+            head = source.read(1024)
+            line_end = head.find(b"\n", head.find(b"DATASET"))
+            if head.find(b"DATASET") < 0 or line_end < 0:
+                raise FormatError("meshio wrote no DATASET line", path)
+            target.write(head[: line_end + 1] + section + head[line_end + 1 :])
+            shutil.copyfileobj(source, target, 1 << 22)
+    finally:
+        staged.unlink(missing_ok=True)
+
+
+def read_legacy_header(path: Path) -> dict[str, Any] | None:
+    """The header of a legacy ``.vtk`` written by geobrep, or None."""
+    with path.open("rb") as stream:
+        head = stream.read(_LEGACY_HEAD)
+    marker = f"\n{HEADER_ARRAY} 1 ".encode()
+    where = head.find(marker)
+    points = head.find(b"\nPOINTS")
+    if where < 0 or (0 <= points < where):
+        return None
+    line_end = head.find(b"\n", where + 1)
+    fields = head[where + 1 : line_end].split()
+    try:
+        count = int(fields[2])
+    except (IndexError, ValueError):
+        return None
+    binary = b"\nBINARY" in head[:256]
+    start = line_end + 1
+    if binary:
+        raw = np.frombuffer(head[start : start + count], dtype=np.uint8)
+    else:
+        stop = head.find(b"\n", start)
+        raw = np.array(head[start:stop].split(), dtype=np.uint8)
+    if raw.size != count:
+        return None
+    return decode_header(raw)

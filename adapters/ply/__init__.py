@@ -1,0 +1,74 @@
+"""Lossless PLY through ``plyfile``: binary or ASCII, float64 coordinates, every property.
+
+Point sets, surfaces and polylines of a scene go into one file with their names, ids, patch
+labels and properties (see :mod:`geobrep.adapters.ply.codec`); PLY files from other programs
+read as one surface keeping every vertex and face property.
+
+>>> import geobrep, tempfile, pathlib
+>>> scene = geobrep.datasets.faulted_layer_cake()
+>>> path = geobrep.write(scene, pathlib.Path(tempfile.mkdtemp()) / "cake.ply")
+>>> geobrep.read(path).surfaces == scene.surfaces
+True
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from pydantic import BaseModel, ConfigDict
+
+from geobrep.adapters.ply.codec import read_ply, write_ply
+from geobrep.capabilities import restrict_scene
+from geobrep.hookspecs import hookimpl
+from geobrep.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.scene import Scene
+
+__all__ = ["CAPABILITIES", "PlyOptions", "geobrep_register_formats", "read_ply", "write_ply"]
+
+CAPABILITIES = FormatCapabilities(
+    entity_types=frozenset({"PointSet", "PolyLine", "Surface"}),
+    point_data=True,
+    cell_data=True,
+    names=True,
+    ids=True,
+    crs=True,
+    multiple_entities=True,
+)
+
+
+class PlyOptions(BaseModel):
+    """Options of the ``ply`` writer."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    binary: bool = True
+    """Little-endian binary (compact, fast); False writes ASCII. Both are exact."""
+
+
+def _read(path: Path, options: BaseModel) -> Scene:
+    return read_ply(path)
+
+
+def _write(scene: Scene, path: Path, options: PlyOptions) -> None:
+    write_ply(restrict_scene(scene, CAPABILITIES), path, binary=options.binary)
+
+
+def _sniff(head: bytes) -> bool:
+    return head.startswith(b"ply\n") or head.startswith(b"ply\r\n")
+
+
+@hookimpl
+def geobrep_register_formats(registry: FormatRegistry) -> None:
+    """Register ``ply``."""
+    registry.add(
+        FormatSpec(
+            name="ply",
+            description="Stanford PLY (plyfile): exact, all vertex and face properties",
+            extensions=(".ply",),
+            reader=_read,
+            writer=_write,
+            sniff=_sniff,
+            options=PlyOptions,
+            capabilities=CAPABILITIES,
+        )
+    )

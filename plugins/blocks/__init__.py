@@ -1,0 +1,36 @@
+"""The built-in block builder: automatic block topology from conformal surfaces.
+
+Registers the ``blocks`` builder (:class:`~geobrep.registry.BuilderSpec`), reached through
+``geobrep.build_blocks(scene)`` and ``geobrep blocks IN... OUT``. The method follows An, Liu and
+Wang (2012), "Automatic construction of topological relationship of 3D geological blocks based on
+stratified geological structure", taken from a plain triangle soup to validated blocks; see
+``docs/blocks.md``.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from geobrep.hookspecs import hookimpl
+
+if TYPE_CHECKING:
+    from geobrep.registry import BuilderRegistry
+
+__all__ = ["geobrep_register_builders"]
+
+
+@hookimpl
+def geobrep_register_builders(registry: BuilderRegistry) -> None:
+    from geobrep.plugins.blocks.builder import build_blocks
+    from geobrep.plugins.blocks.options import BlockBuilderOptions
+    from geobrep.registry import BuilderSpec
+
+    registry.add(
+        BuilderSpec(
+            name="blocks",
+            description="Closed, oriented blocks and their topology from conformal surfaces",
+            function=build_blocks,
+            input_types=("Surface",),
+            options=BlockBuilderOptions,
+        )
+    )

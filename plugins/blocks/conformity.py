@@ -1,0 +1,301 @@
+"""Detect non-conformal input, which would otherwise give a wrong block set.
+
+* **Crossings and touches**: in a conformal model two triangles of different surfaces meet only
+  in shared vertices or edges. Pairs that share no vertex (after merging) yet intersect — within
+  the merge tolerance — are surfaces crossing without an intersection line, or T-junctions
+  (a vertex of one surface lying on a triangle of another). Candidates come from a grid broad
+  phase; the narrow phase tests the six edge–triangle combinations of each pair.
+* **Gaps**: a vertex on a free border (an edge used by one triangle) lying within
+  ``gap_tolerance`` of another surface — not one holding it or its neighbours along the border —
+  is a surface that stops just short of the one it should meet.
+
+Both raise a :class:`NonConformalError` (a :class:`~geobrep.errors.TopologyError`) listing
+locations in model coordinates.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep.errors import TopologyError
+from geobrep.plugins.blocks.broad_phase import overlapping_pairs
+from geobrep.plugins.blocks.csr import concatenated_ranges
+from geobrep.plugins.blocks.patches import PatchSplit
+from geobrep.plugins.blocks.soup import Soup
+
+__all__ = [
+    "NonConformalError",
+    "NonConformity",
+    "check_conformity",
+    "point_triangle_distance",
+    "triangles_intersect",
+]
+
+IntArray = NDArray[np.int64]
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+_MAX_LISTED = 8
+
+
+@dataclass(frozen=True)
+class NonConformity:
+    """One defect: ``kind`` is ``"crossing"``, ``"T-junction"`` or ``"gap"``."""
+
+    kind: str
+    surfaces: tuple[str, str]
+    point: tuple[float, float, float]
+    distance: float
+
+
+class NonConformalError(TopologyError):
+    """The surfaces are not conformal; ``defects`` lists where (model coordinates)."""
+
+    def __init__(self, defects: list[NonConformity]) -> None:
+        self.defects = defects
+        grouped: dict[tuple[str, tuple[str, str]], list[NonConformity]] = defaultdict(list)
+        for defect in defects:
+            grouped[(defect.kind, defect.surfaces)].append(defect)
+        parts = []
+        for (kind, (first, second)), items in list(grouped.items())[:_MAX_LISTED]:
+            x, y, z = items[0].point
+            extra = f" ({len(items)} places)" if len(items) > 1 else ""
+            gap = f", {items[0].distance:.3g} apart" if kind == "gap" else ""
+            parts.append(
+                f"{kind} of {first!r} and {second!r} at ({x:.3f}, {y:.3f}, {z:.3f}){gap}{extra}"
+            )
+        more = len(grouped) - _MAX_LISTED
+        tail = f"; and {more} more" if more > 0 else ""
+        super().__init__(
+            f"non-conformal input: {len(defects)} defect(s): " + "; ".join(parts) + tail
+        )
+
+
+# --------------------------------------------------------------------------- kernels
+def _dot(u: FloatArray, v: FloatArray) -> FloatArray:
+    return np.asarray(np.einsum("ij,ij->i", u, v), dtype=np.float64)
+
+
+def _segment_distance(p1: FloatArray, q1: FloatArray, p2: FloatArray, q2: FloatArray) -> FloatArray:
+    """Distance between segments ``p1q1`` and ``p2q2`` (rows), clamped closest points."""
+    d1, d2, r = q1 - p1, q2 - p2, p1 - p2
+    a, e, f = _dot(d1, d1), _dot(d2, d2), _dot(d2, r)
+    c, b = _dot(d1, r), _dot(d1, d2)
+    denom = a * e - b * b
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.where(denom > 0.0, np.clip((b * f - c * e) / denom, 0.0, 1.0), 0.0)
+        t = (b * s + f) / e
+        s = np.where(
+            t < 0.0, np.clip(-c / a, 0.0, 1.0), np.where(t > 1.0, np.clip((b - c) / a, 0.0, 1.0), s)
+        )
+    t = np.clip(t, 0.0, 1.0)
+    gap = p1 + d1 * s[:, None] - (p2 + d2 * t[:, None])
+    return np.asarray(np.linalg.norm(gap, axis=1), dtype=np.float64)
+
+
+def _inside(
+    x: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray, unit: FloatArray, tol: float
+) -> BoolArray:
+    """Whether points ``x`` of the triangles' planes lie in the triangles (within ``tol``)."""
+    inside = np.ones(x.shape[0], dtype=np.bool_)
+    for p, q in ((a, b), (b, c), (c, a)):
+        edge = q - p
+        reach = _dot(np.cross(edge, x - p), unit) / np.linalg.norm(edge, axis=1)
+        inside &= reach >= -tol
+    return inside
+
+
+def point_triangle_distance(
+    x: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray
+) -> FloatArray:
+    """Distance from each point to its triangle (rows).
+
+    >>> import numpy as np
+    >>> tri = [np.array([[0.0, 0, 0]]), np.array([[1.0, 0, 0]]), np.array([[0.0, 1, 0]])]
+    >>> point_triangle_distance(np.array([[0.2, 0.2, 3.0], [2.0, 0, 0]]).reshape(2, 3),
+    ...                         *[np.repeat(t, 2, axis=0) for t in tri]).tolist()
+    [3.0, 1.0]
+    """
+    normal = np.cross(b - a, c - a)
+    unit = normal / np.linalg.norm(normal, axis=1)[:, None]
+    height = _dot(x - a, unit)
+    foot = x - height[:, None] * unit
+    result = np.abs(height)
+    outside = ~_inside(foot, a, b, c, unit, 0.0)
+    if outside.any():
+        xs = x[outside]
+        best = np.full(xs.shape[0], np.inf)
+        for p, q in ((a, b), (b, c), (c, a)):
+            p, q = p[outside], q[outside]
+            edge = q - p
+            t = np.clip(_dot(xs - p, edge) / _dot(edge, edge), 0.0, 1.0)
+            best = np.minimum(best, np.linalg.norm(xs - (p + t[:, None] * edge), axis=1))
+        result[outside] = best
+    return np.asarray(result, dtype=np.float64)
+
+
+def _segment_hits_triangle(
+    p: FloatArray, q: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray, tol: float
+) -> BoolArray:
+    """Whether segments ``pq`` meet triangles ``abc`` (closed, within ``tol``)."""
+    normal = np.cross(b - a, c - a)
+    unit = normal / np.linalg.norm(normal, axis=1)[:, None]
+    dp, dq = _dot(p - a, unit), _dot(q - a, unit)
+    on_p, on_q = np.abs(dp) <= tol, np.abs(dq) <= tol
+    hits = np.zeros(p.shape[0], dtype=np.bool_)
+    coplanar = on_p & on_q
+    crossing = ~coplanar & ((dp * dq < 0.0) | on_p | on_q)
+    if crossing.any():
+        i = np.flatnonzero(crossing)
+        t = np.where(on_p[i], 0.0, np.where(on_q[i], 1.0, dp[i] / (dp[i] - dq[i])))
+        x = p[i] + t[:, None] * (q[i] - p[i])
+        hits[i] = _inside(x, a[i], b[i], c[i], unit[i], tol)
+    if coplanar.any():
+        i = np.flatnonzero(coplanar)
+        near = _inside(p[i], a[i], b[i], c[i], unit[i], tol) | _inside(
+            q[i], a[i], b[i], c[i], unit[i], tol
+        )
+        for u, v in ((a, b), (b, c), (c, a)):
+            near |= _segment_distance(p[i], q[i], u[i], v[i]) <= tol
+        hits[i] = near
+    return hits
+
+
+def triangles_intersect(first: FloatArray, second: FloatArray, tol: float) -> BoolArray:
+    """Whether triangles ``first[i]`` and ``second[i]`` ((K, 3, 3) corners) meet within ``tol``.
+
+    >>> import numpy as np
+    >>> flat = np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0]]], dtype=float)
+    >>> upright = np.array([[[0.5, 0.5, -1], [0.5, 0.5, 1], [1.5, 0.5, 0]]], dtype=float)
+    >>> triangles_intersect(flat, upright, 1e-9).tolist()
+    [True]
+    >>> triangles_intersect(flat, upright + 5.0, 1e-9).tolist()
+    [False]
+    """
+    hits = np.zeros(first.shape[0], dtype=np.bool_)
+    for one, other in ((first, second), (second, first)):
+        a, b, c = other[:, 0], other[:, 1], other[:, 2]
+        for j in range(3):
+            todo = ~hits
+            if not todo.any():
+                return hits
+            p, q = one[todo, j], one[todo, (j + 1) % 3]
+            hits[todo] = _segment_hits_triangle(p, q, a[todo], b[todo], c[todo], tol)
+    return hits
+
+
+# --------------------------------------------------------------------------- checks
+def _vertex_triangle_distance(points: FloatArray, triangles: FloatArray) -> FloatArray:
+    """Smallest distance from any of the 3 ``points[i]`` to triangle ``triangles[i]``."""
+    k = points.shape[0]
+    flat = points.reshape(-1, 3)
+    a, b, c = (np.repeat(triangles[:, m], 3, axis=0) for m in range(3))
+    distance: FloatArray = point_triangle_distance(flat, a, b, c).reshape(k, 3).min(axis=1)
+    return distance
+
+
+def _crossings(soup: Soup, tol: float) -> list[NonConformity]:
+    local = soup.local(soup.vertices)
+    corners = local[soup.triangles]
+    i, j = overlapping_pairs(corners, soup.triangle_surface, margin=tol)
+    if i.size == 0:
+        return []
+    ti, tj = soup.triangles[i], soup.triangles[j]
+    shared = (ti[:, :, None] == tj[:, None, :]).any(axis=(1, 2))
+    i, j = i[~shared], j[~shared]
+    hit = triangles_intersect(corners[i], corners[j], tol)
+    i, j = i[hit], j[hit]
+    if i.size == 0:
+        return []
+    touch = np.minimum(
+        _vertex_triangle_distance(corners[i], corners[j]),
+        _vertex_triangle_distance(corners[j], corners[i]),
+    )
+    middle = 0.5 * (corners[i].mean(axis=1) + corners[j].mean(axis=1)) + soup.centre
+    surface = soup.triangle_surface
+    return [
+        NonConformity(
+            kind="T-junction" if d <= tol else "crossing",
+            surfaces=(soup.surface_name(int(surface[a])), soup.surface_name(int(surface[b]))),
+            point=(float(m[0]), float(m[1]), float(m[2])),
+            distance=float(d),
+        )
+        for a, b, d, m in zip(i.tolist(), j.tolist(), touch.tolist(), middle, strict=True)
+    ]
+
+
+def _allowed_surfaces(soup: Soup, border: IntArray) -> IntArray:
+    """Keys ``vertex · S + surface``: surfaces holding a border vertex or a border neighbour."""
+    n_surfaces = len(soup.surfaces)
+    ring_vertex = np.concatenate([border[:, 0], border[:, 1], border[:, 0], border[:, 1]])
+    ring_other = np.concatenate([border[:, 1], border[:, 0], border[:, 0], border[:, 1]])
+    wanted = np.zeros(soup.vertices.shape[0], dtype=np.bool_)
+    wanted[ring_other] = True
+    corner_vertex = soup.triangles.reshape(-1)
+    keep = wanted[corner_vertex]
+    held = np.unique(corner_vertex[keep] * n_surfaces + np.repeat(soup.triangle_surface, 3)[keep])
+    held_vertex, held_surface = held // n_surfaces, held % n_surfaces
+    start = np.searchsorted(held_vertex, ring_other, side="left")
+    count = np.searchsorted(held_vertex, ring_other, side="right") - start
+    rows = concatenated_ranges(start, count)
+    return np.unique(np.repeat(ring_vertex, count) * n_surfaces + held_surface[rows])
+
+
+def _gaps(soup: Soup, split: PatchSplit, gap_tolerance: float, tol: float) -> list[NonConformity]:
+    free = np.flatnonzero(np.diff(split.offsets) == 1)
+    if free.size == 0 or gap_tolerance <= 0.0:
+        return []
+    border = split.edges[free]
+    owner = np.full(soup.vertices.shape[0], -1, dtype=np.int64)
+    border_surface = soup.triangle_surface[split.incident_triangles[split.offsets[free]]]
+    owner[border[:, 0]] = border_surface
+    owner[border[:, 1]] = border_surface
+    points = np.unique(border)
+    local = soup.local(soup.vertices)
+    corners = local[soup.triangles]
+    n_points = points.shape[0]
+    dots = np.repeat(local[points][:, None, :], 3, axis=1)
+    groups = np.concatenate([np.zeros(n_points, np.int64), np.ones(soup.n_triangles, np.int64)])
+    p, t = overlapping_pairs(np.concatenate([dots, corners]), groups, margin=0.5 * gap_tolerance)
+    vertex, t = points[p], t - n_points
+    n_surfaces = len(soup.surfaces)
+    allowed = np.isin(
+        vertex * n_surfaces + soup.triangle_surface[t], _allowed_surfaces(soup, border)
+    )
+    vertex, t = vertex[~allowed], t[~allowed]
+    if vertex.size == 0:
+        return []
+    distance = point_triangle_distance(local[vertex], corners[t, 0], corners[t, 1], corners[t, 2])
+    close = distance <= gap_tolerance
+    vertex, t, distance = vertex[close], t[close], distance[close]
+    # One defect per border vertex: its nearest other surface.
+    order = np.lexsort((distance, vertex))
+    first = np.ones(order.shape[0], dtype=np.bool_)
+    first[1:] = vertex[order][1:] != vertex[order][:-1]
+    defects = []
+    for k in order[first].tolist():
+        v = int(vertex[k])
+        x, y, z = (float(c) for c in soup.vertices[v])
+        defects.append(
+            NonConformity(
+                kind="T-junction" if distance[k] <= tol else "gap",
+                surfaces=(
+                    soup.surface_name(int(owner[v])),
+                    soup.surface_name(int(soup.triangle_surface[t[k]])),
+                ),
+                point=(x, y, z),
+                distance=float(distance[k]),
+            )
+        )
+    return defects
+
+
+def check_conformity(soup: Soup, split: PatchSplit, gap_tolerance: float) -> None:
+    """Raise :class:`NonConformalError` when surfaces cross, touch or leave gaps."""
+    defects = _crossings(soup, soup.tolerance) + _gaps(soup, split, gap_tolerance, soup.tolerance)
+    if defects:
+        raise NonConformalError(defects)

@@ -1,0 +1,38 @@
+"""Grouped-row helpers shared by the stages (rows delimited by offsets, or labelled by group)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["concatenated_ranges", "group_sums"]
+
+IntArray = NDArray[np.int64]
+FloatArray = NDArray[np.float64]
+
+
+def concatenated_ranges(starts: IntArray, counts: IntArray) -> IntArray:
+    """``range(start, start + count)`` for every pair, concatenated, without a Python loop.
+
+    >>> import numpy as np
+    >>> concatenated_ranges(np.array([5, 0]), np.array([2, 3])).tolist()
+    [5, 6, 0, 1, 2]
+    """
+    total = int(counts.sum())
+    shift = np.repeat(starts - (np.cumsum(counts) - counts), counts)
+    ranges: IntArray = np.arange(total, dtype=np.int64) + shift.astype(np.int64)
+    return ranges
+
+
+def group_sums(labels: IntArray, weights: FloatArray, n_groups: int) -> FloatArray:
+    """Sum of ``weights`` per label (float64, ``n_groups`` long); 2-D weights sum per column.
+
+    >>> import numpy as np
+    >>> group_sums(np.array([1, 0, 1]), np.array([2.0, 3.0, 4.0]), 3).tolist()
+    [3.0, 6.0, 0.0]
+    """
+    if weights.ndim == 2:
+        return np.stack(
+            [group_sums(labels, weights[:, k], n_groups) for k in range(weights.shape[1])], axis=1
+        )
+    return np.asarray(np.bincount(labels, weights=weights, minlength=n_groups), dtype=np.float64)

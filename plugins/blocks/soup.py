@@ -1,0 +1,124 @@
+"""The triangle soup: every surface's triangles over one table of merged (welded) vertices.
+
+Surfaces of a conformal model meet along shared vertices; files store each surface with its own
+copy of them, so colocated vertices are merged first, within a tolerance relative to the model
+size. Triangles that collapse in the merge (two corners welded together) are dropped and
+counted. Quads are split along their 0-2 diagonal.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep.entities import Surface
+from geobrep.errors import DegenerateGeometryError
+from geobrep.geometry import mesh
+
+__all__ = ["Soup", "build_soup"]
+
+IntArray = NDArray[np.int64]
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+
+@dataclass(frozen=True)
+class Soup:
+    """Merged vertices and the live triangles of all surfaces.
+
+    ``triangle_surface[t]`` is the position of triangle ``t``'s surface in ``surfaces`` and
+    ``triangle_face[t]`` the face of that surface it comes from. ``vertex_maps[s][i]`` is the
+    merged vertex of vertex ``i`` of surface ``s``. Triangles of one surface are contiguous and
+    surfaces come in order.
+    """
+
+    surfaces: tuple[Surface, ...]
+    vertices: FloatArray
+    triangles: IntArray
+    triangle_surface: IntArray
+    triangle_face: IntArray
+    vertex_maps: tuple[IntArray, ...]
+    merged_vertices: int
+    degenerate_triangles: int
+    tolerance: float
+    centre: FloatArray
+    diagonal: float
+
+    @property
+    def n_triangles(self) -> int:
+        return int(self.triangles.shape[0])
+
+    def subset(self, keep: BoolArray) -> Soup:
+        """The same soup with only the triangles where ``keep`` is true."""
+        return replace(
+            self,
+            triangles=self.triangles[keep],
+            triangle_surface=self.triangle_surface[keep],
+            triangle_face=self.triangle_face[keep],
+        )
+
+    def surface_name(self, index: int) -> str:
+        surface = self.surfaces[index]
+        return surface.name or surface.label
+
+    def local(self, points: FloatArray) -> FloatArray:
+        """Coordinates relative to the model centre (products keep full precision there)."""
+        return np.asarray(points - self.centre, dtype=np.float64)
+
+
+def build_soup(
+    surfaces: tuple[Surface, ...], tolerance: float | None, relative_tolerance: float
+) -> Soup:
+    """Merge the surfaces' vertices within the tolerance and collect their triangles.
+
+    >>> import geobrep
+    >>> scene = geobrep.datasets.faulted_layer_cake()
+    >>> soup = build_soup(scene.surfaces, None, 1e-7)
+    >>> soup.n_triangles == sum(s.n_faces for s in scene.surfaces), soup.merged_vertices > 0
+    (True, True)
+    """
+    if not surfaces:
+        raise DegenerateGeometryError("block builder: the scene has no surfaces to build from")
+    vertex_counts = np.array([s.n_vertices for s in surfaces], dtype=np.int64)
+    vertex_offsets = np.concatenate([[0], np.cumsum(vertex_counts)])
+    all_vertices = np.concatenate([s.vertices for s in surfaces]).astype(np.float64, copy=False)
+    if all_vertices.shape[0] == 0:
+        raise DegenerateGeometryError("block builder: the surfaces have no vertices")
+    lower, upper = all_vertices.min(axis=0), all_vertices.max(axis=0)
+    centre = 0.5 * (lower + upper)
+    diagonal = float(np.linalg.norm(upper - lower))
+    if tolerance is None:
+        tolerance = relative_tolerance * diagonal
+    merged, inverse = mesh.merge_close_vertices(all_vertices, tolerance)
+
+    triangle_parts: list[IntArray] = []
+    surface_parts: list[IntArray] = []
+    face_parts: list[IntArray] = []
+    for index, surface in enumerate(surfaces):
+        triangles, source = mesh.triangulate(surface.faces)
+        triangle_parts.append(inverse[triangles + vertex_offsets[index]])
+        surface_parts.append(np.full(triangles.shape[0], index, dtype=np.int64))
+        face_parts.append(source)
+    triangles = np.concatenate(triangle_parts).reshape(-1, 3)
+    collapsed = (
+        (triangles[:, 0] == triangles[:, 1])
+        | (triangles[:, 1] == triangles[:, 2])
+        | (triangles[:, 0] == triangles[:, 2])
+    )
+    keep = ~collapsed
+    maps = tuple(inverse[vertex_offsets[i] : vertex_offsets[i + 1]] for i in range(len(surfaces)))
+    return Soup(
+        surfaces=surfaces,
+        vertices=merged,
+        triangles=triangles[keep],
+        triangle_surface=np.concatenate(surface_parts)[keep],
+        triangle_face=np.concatenate(face_parts)[keep],
+        vertex_maps=maps,
+        merged_vertices=int(all_vertices.shape[0] - merged.shape[0]),
+        degenerate_triangles=int(collapsed.sum()),
+        tolerance=float(tolerance),
+        centre=centre,
+        diagonal=diagonal,
+    )

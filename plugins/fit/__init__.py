@@ -1,0 +1,92 @@
+"""Built-in fitters: NURBS skinning, least-squares approximation, kriging, and the hybrid workflow.
+
+Registered through ``geobrep_register_fitters`` like any third-party plugin; ``geobrep.fit(points,
+method=...)`` dispatches to them. Every fitter returns a :class:`geobrep.fitting.FitResult` with the
+surface and its accuracy report. Heavy modules are imported when a fitter runs, so loading the
+plugin stays cheap.
+
+* ``skinning``: interpolate ordered sections (rows), then across them; exact (NurbsSurface);
+* ``approximation``: least squares + bending energy, boundary curves held exactly (NurbsSurface);
+* ``kriging``: ordinary / universal kriging onto a grid, with the kriging variance (Surface);
+* ``hybrid``: skin the dense core, approximate the sparse rim against it (NurbsSurface).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from geobrep.hookspecs import hookimpl
+from geobrep.plugins.fit.options import (
+    ApproximationOptions,
+    HybridOptions,
+    KrigingOptions,
+    SkinningOptions,
+)
+from geobrep.registry import FitterRegistry, FitterSpec
+
+__all__ = ["geobrep_register_fitters"]
+
+
+def _skinning(entities: list[Any], options: SkinningOptions) -> Any:
+    from geobrep.plugins.fit.skinning_fitter import fit_skinning
+
+    return fit_skinning(entities, options)
+
+
+def _approximation(entities: list[Any], options: ApproximationOptions) -> Any:
+    from geobrep.plugins.fit.approximation import fit_approximation
+
+    return fit_approximation(entities, options)
+
+
+def _kriging(entities: list[Any], options: KrigingOptions) -> Any:
+    from geobrep.plugins.fit.kriging import fit_kriging
+
+    return fit_kriging(entities, options)
+
+
+def _hybrid(entities: list[Any], options: HybridOptions) -> Any:
+    from geobrep.plugins.fit.hybrid import fit_hybrid
+
+    return fit_hybrid(entities, options)
+
+
+@hookimpl
+def geobrep_register_fitters(registry: FitterRegistry) -> None:
+    """Register ``skinning``, ``approximation``, ``kriging`` and ``hybrid``."""
+    registry.add(
+        FitterSpec(
+            name="skinning",
+            description="NURBS skinning: interpolate ordered sections, exact at every point",
+            function=_skinning,
+            input_types=("PointSet", "PolyLine"),
+            options=SkinningOptions,
+        )
+    )
+    registry.add(
+        FitterSpec(
+            name="approximation",
+            description="NURBS least squares with smoothing, ε-driven net size, boundary curves",
+            function=_approximation,
+            input_types=("PointSet", "PolyLine"),
+            options=ApproximationOptions,
+        )
+    )
+    registry.add(
+        FitterSpec(
+            name="kriging",
+            description="Ordinary/universal kriging onto a grid (prediction + variance)",
+            function=_kriging,
+            input_types=("PointSet", "PolyLine"),
+            options=KrigingOptions,
+        )
+    )
+    registry.add(
+        FitterSpec(
+            name="hybrid",
+            description="Skin the dense core, approximate the sparse rim against it (Li 2011)",
+            function=_hybrid,
+            input_types=("PointSet",),
+            options=HybridOptions,
+        )
+    )

@@ -1,0 +1,24 @@
+"""The examples in the GOCAD adapter's docstrings (and geobrep.arcs) run and give their output."""
+
+from __future__ import annotations
+
+import doctest
+import importlib
+
+import pytest
+
+MODULES = [
+    "geobrep.arcs",
+    "geobrep.adapters.gocad.headers",
+    "geobrep.adapters.gocad.lexer",
+    "geobrep.adapters.gocad.numbers",
+    "geobrep.adapters.gocad.options",
+]
+
+
+@pytest.mark.parametrize("name", MODULES)
+def test_module_examples(name: str) -> None:
+    module = importlib.import_module(name)
+    result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted > 0
+    assert result.failed == 0

@@ -1,0 +1,24 @@
+"""The docstring examples of the voxelizer's modules and the Morton-code kernel run."""
+
+from __future__ import annotations
+
+import doctest
+import importlib
+
+import pytest
+
+MODULES = [
+    "geobrep.geometry.morton",
+    "geobrep.plugins.voxelize.rasterize",
+    "geobrep.plugins.voxelize.depth_buffers",
+    "geobrep.plugins.voxelize.parity",
+    "geobrep.plugins.voxelize.merge",
+]
+
+
+@pytest.mark.parametrize("name", MODULES)
+def test_examples(name: str) -> None:
+    module = importlib.import_module(name)
+    result = doctest.testmod(module, optionflags=doctest.ELLIPSIS, report=True)
+    assert result.attempted > 0
+    assert result.failed == 0
