@@ -27,7 +27,7 @@ $(STAMPS)/base: pyproject.toml | $(PY)
 	@mkdir -p $(STAMPS) && touch $@
 
 $(STAMPS)/test: pyproject.toml $(STAMPS)/base
-	$(PY) -m pip install $(PIP_QUIET) -e ".[test,dev,open3d]"
+	$(PY) -m pip install $(PIP_QUIET) -e ".[test,dev,open3d,gis]"
 	@mkdir -p $(STAMPS) && touch $@
 
 # open3d (the `open3d` extra) needs system libraries that a bare machine may lack.
@@ -46,7 +46,11 @@ sysdeps:
 	  fi; \
 	fi
 
-demo: $(STAMPS)/base
+$(STAMPS)/demo: pyproject.toml $(STAMPS)/base
+	$(PY) -m pip install $(PIP_QUIET) -e ".[viz]"
+	@mkdir -p $(STAMPS) && touch $@
+
+demo: $(STAMPS)/demo
 	$(VENV)/bin/geobrep demo --output demo-output
 
 lint: $(STAMPS)/test
@@ -72,6 +76,7 @@ schemas: $(STAMPS)/base
 	$(PY) -m geobrep.schemas
 
 bench: $(STAMPS)/test
+	$(PY) -m pip install $(PIP_QUIET) -e ".[bench]"
 	$(PY) benchmarks/run_all.py
 
 clean:

@@ -42,11 +42,16 @@ from geobrep.errors import (
     TopologyError,
     UnknownFormatError,
 )
+from geobrep.building import build_blocks
+from geobrep.clipping import clip, clip_box, section
+from geobrep.conversion import ConversionSummary, FileReport, convert
+from geobrep.fitting import FitReport, FitResult, fit
 from geobrep.geometry import BoundingBox, Plane
 from geobrep.io import read, write
 from geobrep.properties import Property
 from geobrep.scene import Group, Scene
 from geobrep.topology import Arc, Corner, Patch, Topology
+from geobrep.voxelization import VoxelizationWarning, voxelize
 
 if TYPE_CHECKING:
     from geobrep import datasets, plugins
@@ -59,12 +64,16 @@ __all__ = [
     "Arc",
     "Block",
     "BoundingBox",
+    "ConversionSummary",
     "Corner",
     "DegenerateGeometryError",
     "Entity",
     "EntityNotFoundError",
     "EntityValidationError",
     "FileAccessError",
+    "FileReport",
+    "FitReport",
+    "FitResult",
     "FormatError",
     "GeobrepError",
     "Group",
@@ -86,10 +95,18 @@ __all__ = [
     "Topology",
     "TopologyError",
     "UnknownFormatError",
+    "VoxelizationWarning",
     "__version__",
+    "build_blocks",
+    "clip",
+    "clip_box",
+    "convert",
     "datasets",
+    "fit",
     "plugins",
     "read",
+    "section",
+    "voxelize",
     "write",
 ]
 

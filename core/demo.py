@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from geobrep import datasets
+from geobrep import building, clipping, conversion, datasets, fitting, voxelization
 from geobrep.io import atomic_write, read, write
 from geobrep.scene import Scene
 
@@ -119,6 +119,11 @@ STAGES: list[tuple[str, Callable[[DemoContext], None]]] = [
     ("model", _model_stage),
     ("blocks", _blocks_stage),
     ("native", _native_stage),
+    ("clip", clipping.demo_stage),
+    ("block_builder", building.demo_stage),
+    ("voxelize", voxelization.demo_stage),
+    ("fit", fitting.demo_stage),
+    ("conversion", conversion.demo_stage),
 ]
 
 

@@ -31,6 +31,13 @@ DOCTEST_MODULES = [
     "geobrep.scene",
     "geobrep.io",
     "geobrep.voxelization",
+    "geobrep.clipping",
+    "geobrep.cli.clip",
+    "geobrep.building",
+    "geobrep.cli.blocks",
+    "geobrep.capabilities",
+    "geobrep.cell_layout",
+    "geobrep.conversion",
     "geobrep.datasets.layer_cake",
     "geobrep.datasets.scattered",
     "geobrep.schemas",
@@ -44,6 +51,8 @@ OWNED_ELSEWHERE = (
     "geobrep.plugin_loader",
     "geobrep.hookspecs",
     "geobrep.plugins",
+    "geobrep.fitting",
+    "geobrep.nurbs_eval",
 )
 
 

@@ -183,6 +183,12 @@ def _normalised_body(chunk: bytes, keyword: bytes) -> bytes:
     return body[len(head) :].replace(b"\n" + head, b"\n")
 
 
+def _renormalised(raw: bytes, keyword: bytes) -> bytes:
+    """The run's lines with single spaces and no tabs or trailing spaces, keywords kept."""
+    head = keyword + b" "
+    return head + _normalised_body(raw, keyword).replace(b"\n", b"\n" + head)
+
+
 _TO_COMMAS = bytes.maketrans(b" \n", b",,")
 _NUMBER_BYTES = b"0123456789.+-eE \n"
 _INTEGER_BYTES = b"0123456789- \n"
@@ -213,14 +219,14 @@ def parse_run(source: Source, run: Run, integer: bool) -> NDArray[Any]:
     keyword = run.keyword.encode()
     raw = source.data[run.start : run.end]
     if b"\t" in raw or raw.endswith(b" "):
-        raw = keyword + b" " + _normalised_body(raw, keyword).replace(b"\n", b"\n" + keyword + b" ")
+        raw = _renormalised(raw, keyword)
     if raw.translate(None, _NUMBER_BYTES + keyword):
         raise BulkParseError  # letters, flags, "inf", "1.#INF": only plain numbers go in bulk
     buffer = np.frombuffer(raw, dtype=np.uint8)
     newline = buffer == 10
     separators = np.flatnonzero(newline | (buffer == 32))
     if separators.size and (np.diff(separators) == 1).any():  # repeated or trailing spaces
-        raw = keyword + b" " + _normalised_body(raw, keyword).replace(b"\n", b"\n" + keyword + b" ")
+        raw = _renormalised(raw, keyword)
         buffer = np.frombuffer(raw, dtype=np.uint8)
         newline = buffer == 10
         separators = np.flatnonzero(newline | (buffer == 32))
@@ -240,6 +246,8 @@ def parse_run(source: Source, run: Run, integer: bool) -> NDArray[Any]:
         raise BulkParseError
     size = run.count * width
     letters = bytes(set(keyword))
+    if len(raw) - len(raw.translate(None, letters)) != run.count * len(keyword):
+        raise BulkParseError  # keyword letters elsewhere than in the keywords ("3X")
     if not raw.translate(None, _INTEGER_BYTES + keyword):  # integers only: numpy parses them
         text = raw.translate(bytes.maketrans(letters, b" " * len(letters)))
         try:
@@ -260,26 +268,6 @@ def parse_run(source: Source, run: Run, integer: bool) -> NDArray[Any]:
     view[starts + 1 + len(keyword)] = 32  # the byte after each keyword (offset 1 for "[")
     try:
         flat = ORJSON.loads(json)
-        array = np.fromiter(flat, dtype=np.float64, count=len(flat))
-    except (ValueError, TypeError, OverflowError) as exc:
-        raise BulkParseError from exc
-    if array.shape[0] != size:
-        raise BulkParseError
-    return array.reshape(run.count, width)
-    if integer:
-        raise BulkParseError
-    try:
-        flat = ORJSON.loads(b"[" + body.translate(_TO_COMMAS) + b"]")
-        array = np.fromiter(flat, dtype=np.float64, count=len(flat))
-    except (ValueError, TypeError, OverflowError) as exc:
-        raise BulkParseError from exc
-    if array.shape[0] != size:
-        raise BulkParseError
-    return array.reshape(run.count, width)
-    if integer:
-        raise BulkParseError
-    try:
-        flat = ORJSON.loads(b"[" + body.translate(_TO_COMMAS) + b"]")
         array = np.fromiter(flat, dtype=np.float64, count=len(flat))
     except (ValueError, TypeError, OverflowError) as exc:
         raise BulkParseError from exc

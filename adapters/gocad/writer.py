@@ -160,7 +160,8 @@ class _Writer:
         borders = [
             (int(a), int(b)) for a, b in meta.get("borders", []) if 0 <= a < n and 0 <= b < n
         ]
-        if not bstones and not borders:
+        if not bstones and not borders and meta.get("type") != "TSurf":
+            # not read from GOCAD: BSTONE/BORDER from the scene's corners and arcs
             bstones, borders = self._derived_borders(surface)
         for v in bstones:
             out.add(f"BSTONE {v + 1}")

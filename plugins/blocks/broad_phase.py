@@ -189,12 +189,12 @@ def overlapping_pairs(
     reach = hi - lo  # 0 or 1 per axis: pieces fit in a cell
     piece_parts, key_parts, code_parts = [], [], []
     everything = np.arange(m, dtype=np.int64)
-    for code in range(8):
-        dx, dy, dz = code >> 2, (code >> 1) & 1, code & 1
+    for step in range(8):
+        dx, dy, dz = step >> 2, (step >> 1) & 1, step & 1
         inside = (reach[:, 0] >= dx) & (reach[:, 1] >= dy) & (reach[:, 2] >= dz)
         piece_parts.append(everything[inside])
         key_parts.append(base[inside] + (dx * strides[0] + dy * strides[1] + dz))
-        code_parts.append(np.full(int(inside.sum()), code, dtype=np.int64))
+        code_parts.append(np.full(int(inside.sum()), step, dtype=np.int64))
     piece = np.concatenate(piece_parts)
     key = np.concatenate(key_parts)
     code = np.concatenate(code_parts)

@@ -314,3 +314,11 @@ def test_groups_nest_and_round_trip(tmp_path: Path) -> None:
     assert child.metadata["gocad"]["member_type"] == "TSurf"
     again = geobrep.read(geobrep.write(scene, tmp_path / "again.gp"))
     assert again == scene
+
+
+def test_garbled_bulk_values_never_parse_silently(tmp_path: Path) -> None:
+    rows = "\n".join(f"PVRTX {k + 1} {k} 0 0 {k}" for k in range(100))
+    for bad in ("3X", "3e", "3-", "1.2.3", "--3", "3P4", "0x10"):
+        text = f"GOCAD VSet 1\nPROPERTIES a\nESIZES 1\n{rows.replace(' 0 0 7', f' 0 0 {bad}')}\nEND"
+        with pytest.raises(geobrep.FormatError, match=r":11: PVRTX: .* is not a number"):
+            geobrep.read(write(tmp_path, text, "bad.vs"))
