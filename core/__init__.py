@@ -15,6 +15,9 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
+from geobrep.building import build_blocks
+from geobrep.clipping import clip, clip_box, section
+from geobrep.conversion import ConversionSummary, FileReport, convert
 from geobrep.crs import CRS
 from geobrep.entities import (
     Annotation,
@@ -42,9 +45,6 @@ from geobrep.errors import (
     TopologyError,
     UnknownFormatError,
 )
-from geobrep.building import build_blocks
-from geobrep.clipping import clip, clip_box, section
-from geobrep.conversion import ConversionSummary, FileReport, convert
 from geobrep.fitting import FitReport, FitResult, fit
 from geobrep.geometry import BoundingBox, Plane
 from geobrep.io import read, write

@@ -41,6 +41,10 @@ DOCTEST_MODULES = [
     "geobrep.datasets.layer_cake",
     "geobrep.datasets.scattered",
     "geobrep.schemas",
+    "geobrep.arcs",
+    "geobrep.crs_ops",
+    "geobrep.feature_tables",
+    "geobrep.map_products",
 ]
 
 #: Modules covered elsewhere (their own doctest runs belong to their suites).

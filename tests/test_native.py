@@ -430,7 +430,9 @@ class TestErrors:
         assert "extension .foo" in message
         assert "native (.geobrep" in message
         assert isinstance(info.value, FormatError)
-        with pytest.raises(UnknownFormatError, match=r"formats that can write: .*native \(.geobrep"):
+        with pytest.raises(
+            UnknownFormatError, match=r"formats that can write: .*native \(.geobrep"
+        ):
             geobrep.write(Scene(), tmp_path / "out.foo")
         assert not (tmp_path / "out.foo").exists()
 

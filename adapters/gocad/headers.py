@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -62,6 +63,8 @@ def color_from_text(text: str) -> list[float] | None:
         try:
             rgba = [float(p) for p in parts]
         except ValueError:
+            return None
+        if not all(math.isfinite(c) for c in rgba):
             return None
         return rgba if len(rgba) == 4 else [*rgba, 1.0]
     return None

@@ -154,9 +154,16 @@ def attach_model3d(
         if keyword == "LAYER":
             for region in entry["items"]:
                 layer_of.setdefault(region, entry["name"])
+    n_tfaces = len(patches)
     for keyword, entry in lists:
         if keyword != "REGION":
             continue
+        if entry["id"] <= n_tfaces or entry["id"] in region_block:
+            builder.warn(
+                f"REGION id {entry['id']} should follow the TFACE ids and be unique; "
+                "it is renumbered when written",
+                entry["line"],
+            )
         sides: list[PatchSide] = []
         for value in entry["items"]:
             tface = abs(value)

@@ -426,6 +426,9 @@ class _Builder:
             )
         )
         for surface in model.get("surfaces", []):
+            if not surface["tfaces"]:
+                self.warn(f"MODEL surface {surface['name']!r} has no TFACE; skipped", obj.line)
+                continue
             self._tsolid_surface(obj, surface, xyz, lookup, tet_id)
 
     def _tsolid_surface(

@@ -62,7 +62,7 @@ def _write_container(scene: Scene, path: Path, compress: bool) -> None:
 
     def store(array: NDArray[Any]) -> str:
         # pydantic may serialise a union member more than once while it picks the matching
-        # type: store each array object once (the scene keeps them alive during the save).
+        # type; store each array object once (the scene keeps them alive during the save).
         name = stored.get(id(array))
         if name is None:
             name = stored[id(array)] = f"arrays/{len(arrays):06d}.npy"

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 import traceback
 from collections.abc import Sequence
-
-import importlib
 from types import ModuleType
 
 from geobrep.errors import GeobrepError
@@ -19,8 +18,17 @@ EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 70, 
 
 #: Subcommand modules of ``geobrep.cli``, each with ``add_parser(subparsers)``, in help order.
 COMMAND_MODULES = (
-    "info", "plugins", "demo", "convert", "render", "reproject",
-    "clip", "section", "blocks", "voxelize", "fit",
+    "info",
+    "plugins",
+    "demo",
+    "convert",
+    "render",
+    "reproject",
+    "clip",
+    "section",
+    "blocks",
+    "voxelize",
+    "fit",
 )
 
 
