@@ -47,7 +47,7 @@ sysdeps:
 	fi
 
 $(STAMPS)/demo: pyproject.toml $(STAMPS)/base
-	$(PY) -m pip install $(PIP_QUIET) -e ".[viz]"
+	$(PY) -m pip install $(PIP_QUIET) -e ".[viz,gis]"
 	@mkdir -p $(STAMPS) && touch $@
 
 demo: $(STAMPS)/demo

@@ -19,6 +19,7 @@ from geobrep.building import build_blocks
 from geobrep.clipping import clip, clip_box, section
 from geobrep.conversion import ConversionSummary, FileReport, convert
 from geobrep.crs import CRS
+from geobrep.crs_ops import from_geodataframe, to_geodataframe
 from geobrep.entities import (
     Annotation,
     Block,
@@ -48,6 +49,7 @@ from geobrep.errors import (
 from geobrep.fitting import FitReport, FitResult, fit
 from geobrep.geometry import BoundingBox, Plane
 from geobrep.io import read, write
+from geobrep.map_products import map_products
 from geobrep.properties import Property
 from geobrep.scene import Group, Scene
 from geobrep.topology import Arc, Corner, Patch, Topology
@@ -103,9 +105,12 @@ __all__ = [
     "convert",
     "datasets",
     "fit",
+    "from_geodataframe",
+    "map_products",
     "plugins",
     "read",
     "section",
+    "to_geodataframe",
     "voxelize",
     "write",
 ]

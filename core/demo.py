@@ -6,6 +6,7 @@ voxelization) add their own stages to :data:`STAGES`.
 
 from __future__ import annotations
 
+import importlib
 import json
 import time
 from collections.abc import Callable
@@ -13,7 +14,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from geobrep import building, clipping, conversion, datasets, fitting, voxelization
+from geobrep import building, clipping, conversion, crs_ops, datasets, fitting, voxelization
+from geobrep.errors import MissingDependencyError, UnknownFormatError
 from geobrep.io import atomic_write, read, write
 from geobrep.scene import Scene
 
@@ -114,6 +116,26 @@ def _native_stage(ctx: DemoContext) -> None:
     )
 
 
+def _gocad_stage(ctx: DemoContext) -> None:
+    """The model through GOCAD Model3d and TSurf files (the ``gocad`` format plugin)."""
+    from geobrep.plugins import registries
+
+    if "gocad" not in registries().formats:
+        ctx.summary["gocad"] = {"status": "skipped", "reason": "format 'gocad' not installed"}
+        ctx.lines.append("gocad: skipped (format plugin not installed)")
+        return
+    importlib.import_module("geobrep.adapters.gocad.demo").demo_stage(ctx)
+
+
+def _gis_stage(ctx: DemoContext) -> None:
+    """Map products as a GeoPackage and the model in WGS 84 (needs the ``gis`` extra)."""
+    try:
+        crs_ops.demo_stage(ctx)
+    except (MissingDependencyError, UnknownFormatError) as exc:
+        ctx.summary["gis"] = {"status": "skipped", "reason": str(exc)}
+        ctx.lines.append(f"gis: skipped ({exc})")
+
+
 #: The demo's stages, in order. Features add theirs here.
 STAGES: list[tuple[str, Callable[[DemoContext], None]]] = [
     ("model", _model_stage),
@@ -124,6 +146,8 @@ STAGES: list[tuple[str, Callable[[DemoContext], None]]] = [
     ("voxelize", voxelization.demo_stage),
     ("fit", fitting.demo_stage),
     ("conversion", conversion.demo_stage),
+    ("gocad", _gocad_stage),
+    ("gis", _gis_stage),
 ]
 
 

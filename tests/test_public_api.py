@@ -60,9 +60,12 @@ EXPECTED_ALL = [
     "convert",
     "datasets",
     "fit",
+    "from_geodataframe",
+    "map_products",
     "plugins",
     "read",
     "section",
+    "to_geodataframe",
     "voxelize",
     "write",
 ]

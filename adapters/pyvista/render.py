@@ -91,6 +91,12 @@ def _datasets(scene: Scene, options: RenderOptions) -> list[tuple[str, Any]]:
 def render_scene(scene: Scene, path: Path, options: RenderOptions) -> None:
     """Render ``scene`` into the PNG file ``path`` off-screen."""
     pv = import_pyvista("rendering pictures")
+    # without a display VTK logs "bad X server connection" although off-screen rendering works
+    with pv.vtk_verbosity("error"):
+        _render(pv, scene, path, options)
+
+
+def _render(pv: Any, scene: Scene, path: Path, options: RenderOptions) -> None:
     items = _datasets(scene, options)
     # centre on the drawn points (not scene.bounds: that caches a value on the caller's scene)
     lows = np.min([np.asarray(d.points, np.float64).min(axis=0) for _, d in items], axis=0)

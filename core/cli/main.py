@@ -33,14 +33,7 @@ COMMAND_MODULES = (
 
 
 def _command_modules() -> list[ModuleType]:
-    modules = []
-    for name in COMMAND_MODULES:
-        try:
-            modules.append(importlib.import_module(f"geobrep.cli.{name}"))
-        except ModuleNotFoundError as exc:  # TEMPORARY while commands are being added
-            if exc.name != f"geobrep.cli.{name}":
-                raise
-    return modules
+    return [importlib.import_module(f"geobrep.cli.{name}") for name in COMMAND_MODULES]
 
 
 def build_parser() -> argparse.ArgumentParser:
