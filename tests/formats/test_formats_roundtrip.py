@@ -15,7 +15,7 @@ from geobrep.io import read, write
 from geobrep.plugins import registries
 from geobrep.scene import Scene
 
-DATA = Path(__file__).parent.parent / "data" / "formats_gocad"
+DATA = Path(__file__).parent.parent / "data" / "gocad"
 GOCAD_FILES = sorted(p.name for p in DATA.glob("*") if p.suffix != ".md")
 
 
