@@ -4,9 +4,10 @@
    (same net size and degrees), error = RMS distance from the data to each surface.
 2. geobrep approximation vs a plain scipy sparse least-squares B-spline fit
    (``NdBSpline.design_matrix`` + ``spsolve`` of the normal equations), 200k points, 60 × 60 net.
-3. geobrep kriging vs PyKrige on 2,000 points to a 200 × 200 grid: the global system against
-   PyKrige's ``vectorized`` backend, the moving neighbourhood against ``backend="C",
-   n_closest_points=30``; scipy's ``RBFInterpolator`` as an accuracy reference.
+3. geobrep kriging vs PyKrige on 2,000 points to 100 × 100 and 200 × 200 grids: the global
+   system against PyKrige's ``vectorized`` backend, the moving neighbourhood against
+   ``backend="C", n_closest_points=30`` (runs alternate; best and median times); scipy's
+   ``RBFInterpolator`` as an accuracy reference.
 
 Needs the test extras (geomdl, pykrige). Timings are the best of several runs (the machine may
 be shared); ratios > 1 mean geobrep is faster. Run: ``python benchmarks/fit.py [--quick]``.
@@ -133,10 +134,29 @@ def scipy_comparison() -> None:
     )
 
 
-def kriging_comparison() -> None:
+def timed(function: Callable[[], Any], repeat: int) -> tuple[float, float, Any]:
+    """Best and median wall time of ``repeat`` runs, and the last result."""
+    times, result = [], None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = function()
+        times.append(time.perf_counter() - start)
+    return min(times), float(np.median(times)), result
+
+
+def kriging_row(label: str, ours: tuple[float, float], theirs: tuple[float, float]) -> None:
+    print(
+        f"  {label:<44} geobrep {ours[0]:6.3f} / {ours[1]:6.3f} s  anchor {theirs[0]:6.3f} / "
+        f"{theirs[1]:6.3f} s (best / median)  speed-up {theirs[0] / ours[0]:4.2f}x / "
+        f"{theirs[1] / ours[1]:4.2f}x"
+    )
+
+
+def kriging_comparison(side: int) -> None:
     from pykrige.ok import OrdinaryKriging
 
-    n, side = (1000, 100) if QUICK else (2000, 200)
+    n = 1000 if QUICK else 2000
+    repeat = 3 if QUICK else 5
     rng = np.random.default_rng(2)
     xy = rng.uniform(0, 1000, (n, 2))
     z = dome_elevation(xy[:, 0], xy[:, 1]) + rng.normal(0, 0.2, n)
@@ -150,40 +170,60 @@ def kriging_comparison() -> None:
         xy[:, 0], xy[:, 1], z, variogram_model="gaussian", variogram_parameters=params
     )
     print(f"ordinary kriging, {n} points to a {side} × {side} grid (gaussian model with nugget)")
-    t_ours, (pred, _) = best_of(lambda: krige(xy, z, nodes, model), 2 if not QUICK else 3)
-    t_vec, (z_vec, _) = best_of(
-        lambda: reference.execute("grid", axis, axis, backend="vectorized"), 1
-    )
-    row(
+    # alternate geobrep and anchor runs so that both see the same machine load
+    ours, theirs = [], []
+    for _ in range(2 if QUICK else 3):
+        ours.append(timed(lambda: krige(xy, z, nodes, model), 1))
+        theirs.append(timed(lambda: reference.execute("grid", axis, axis, backend="vectorized"), 1))
+    pred, var = ours[-1][2]
+    z_vec, var_vec = theirs[-1][2]
+    kriging_row(
         "global system vs PyKrige vectorized",
-        t_ours,
-        t_vec,
-        rms(pred - truth),
-        rms(np.asarray(z_vec).ravel() - truth),
+        (min(t[0] for t in ours), float(np.median([t[0] for t in ours]))),
+        (min(t[0] for t in theirs), float(np.median([t[0] for t in theirs]))),
     )
-    t_near, (near, _) = best_of(lambda: krige(xy, z, nodes, model, n_closest_points=30), 3)
-    t_c, (z_c, _) = best_of(
-        lambda: reference.execute("grid", axis, axis, backend="C", n_closest_points=30), 3
-    )
-    row(
+    ours, theirs = [], []
+    for _ in range(repeat):
+        ours.append(timed(lambda: krige(xy, z, nodes, model, n_closest_points=30), 1))
+        theirs.append(
+            timed(
+                lambda: reference.execute("grid", axis, axis, backend="C", n_closest_points=30), 1
+            )
+        )
+    near, near_var = ours[-1][2]
+    z_c, var_c = theirs[-1][2]
+    kriging_row(
         "moving neighbourhood (30) vs PyKrige C",
-        t_near,
-        t_c,
-        rms(near - truth),
-        rms(np.asarray(z_c).ravel() - truth),
+        (min(t[0] for t in ours), float(np.median([t[0] for t in ours]))),
+        (min(t[0] for t in theirs), float(np.median([t[0] for t in theirs]))),
     )
-    t_rbf, rbf = best_of(
-        lambda: RBFInterpolator(xy, z, kernel="thin_plate_spline", smoothing=1e-3)(nodes), 1
+
+    def relative(a: np.ndarray, b: np.ndarray) -> float:
+        b = np.asarray(b).ravel()
+        return float(np.abs(a - b).max() / np.abs(b).max())
+
+    print(
+        f"  agreement with PyKrige (max relative difference): global {relative(pred, z_vec):.1e}"
+        f" (variance {relative(var, var_vec):.1e}), moving {relative(near, z_c):.1e} "
+        f"(variance {relative(near_var, var_c):.1e})"
     )
     print(
-        f"  accuracy reference: scipy RBFInterpolator (thin plate) RMS error "
-        f"{rms(rbf - truth):.3e} in {t_rbf:.2f} s; kriging {rms(pred - truth):.3e}"
+        f"  RMS error against the true surface: global {rms(pred - truth):.3e} (PyKrige "
+        f"{rms(np.asarray(z_vec).ravel() - truth):.3e}), moving {rms(near - truth):.3e} "
+        f"(PyKrige {rms(np.asarray(z_c).ravel() - truth):.3e})"
     )
-    same = float(np.abs(pred - np.asarray(z_vec).ravel()).max() / np.abs(z_vec).max())
-    print(f"  agreement with PyKrige (global): max relative difference {same:.1e}")
+    if side == 200:
+        t_rbf, rbf = best_of(
+            lambda: RBFInterpolator(xy, z, kernel="thin_plate_spline", smoothing=1e-3)(nodes), 1
+        )
+        print(
+            f"  accuracy reference: scipy RBFInterpolator (thin plate) RMS error "
+            f"{rms(rbf - truth):.3e} in {t_rbf:.2f} s; kriging {rms(pred - truth):.3e}"
+        )
 
 
 if __name__ == "__main__":
     geomdl_comparison()
     scipy_comparison()
-    kriging_comparison()
+    for side in (100, 200):
+        kriging_comparison(side)

@@ -9,8 +9,11 @@ correction. With ``r = L⁻¹ c₀``, ``W = L⁻¹ F``, ``Q = Wᵀ W`` and ``g =
     variance    σ² = C(0) − |r|² + gᵀ Q⁻¹ g
 
 which is PyKrige's bordered system, rearranged: one triangular solve per target instead of a
-product with the inverse. The moving neighbourhood solves each target's bordered system of its
-``k`` nearest data points as one batched solve. Targets go through in blocks to bound memory.
+product with the inverse. The moving neighbourhood uses the same formulas on each target's ``k``
+nearest data: targets that share a neighbour set (common on a grid) share its factorisation, so
+each set is factored once (a batched Cholesky) and each target costs one forward substitution.
+Targets go through in blocks, on several threads, to bound memory; a set whose covariance is
+not numerically positive definite falls back to PyKrige's bordered LU solve.
 
 >>> import numpy as np
 >>> xy = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
@@ -22,13 +25,15 @@ product with the inverse. The moving neighbourhood solves each target's bordered
 
 from __future__ import annotations
 
+import os
 import warnings
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import scipy.linalg as la
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
-from scipy.spatial.distance import cdist
+from scipy.spatial.distance import cdist, pdist, squareform
 
 from geobrep.entities import Entity, Surface
 from geobrep.errors import DegenerateGeometryError, OptionsError
@@ -53,8 +58,12 @@ LABEL = "fitter 'kriging'"
 EPS = 1e-10
 #: Targets per block in the global system (bounds the ``n × block`` work arrays).
 _GLOBAL_BLOCK = 2048
-#: Targets per block in the moving neighbourhood.
-_LOCAL_BLOCK = 8192
+#: Targets per block in the moving neighbourhood (a block's systems stay in cache).
+_LOCAL_BLOCK = 1024
+#: Largest data count for which the moving neighbourhood gathers from the data covariance matrix.
+_TABLE_MAX = 6000
+#: Threads for the moving neighbourhood (blocks are independent).
+_MAX_WORKERS = 8
 
 
 def _drift(xy: FloatArray, linear: bool, scale: float) -> FloatArray:
@@ -66,7 +75,7 @@ def _data_covariance(xy: FloatArray, model: Variogram) -> FloatArray:
     """``C(|xᵢ − xⱼ|)`` with ``C(0) = sill`` on the diagonal only: coincident but distinct data
     points are correlated by the structured part (PyKrige's matrix), so with a nugget they stay
     solvable."""
-    cov = model.covariance(cdist(xy, xy))
+    cov = np.asarray(squareform(model.covariance(pdist(xy))), dtype=np.float64)  # pairs once
     np.fill_diagonal(cov, model.sill)
     return cov
 
@@ -149,6 +158,149 @@ def _global_bordered(
     return prediction, variance
 
 
+def _forward(lower: FloatArray, rhs: FloatArray) -> FloatArray:
+    """Forward substitution ``L x = b`` for a stack ``L (s, k, k)`` and ``b (s, k)``: one
+    vectorised step per row, across the whole stack (a column at a time for ``b (s, k, r)``)."""
+    if rhs.ndim == 3:
+        return np.stack([_forward(lower, rhs[:, :, c]) for c in range(rhs.shape[2])], axis=2)
+    x = np.empty_like(rhs)
+    for j in range(lower.shape[1]):
+        dot = np.einsum("si,si->s", lower[:, j, :j], x[:, :j])
+        x[:, j] = (rhs[:, j] - dot) / lower[:, j, j]
+    return x
+
+
+def _workers() -> int:
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        cores = os.cpu_count() or 1
+    return max(1, min(cores, _MAX_WORKERS))
+
+
+class _Neighbourhoods:
+    """Moving-neighbourhood kriging, one block of targets at a time (read-only shared state,
+    so blocks can run on several threads).
+
+    Each target's system is that of its ``k`` nearest data. Neighbouring targets often share the
+    same neighbour set: targets are grouped by set (a hash of the set, checked exactly), each
+    set's covariance matrix is factored once (Cholesky) and every target of the set needs only
+    one forward substitution, with the formulas of the global system.
+    """
+
+    def __init__(
+        self,
+        xy: FloatArray,
+        z: FloatArray,
+        model: Variogram,
+        linear: bool,
+        exact_at: float | None,
+        scale: float,
+        k: int,
+        n_targets: int,
+    ) -> None:
+        n = xy.shape[0]
+        self.tree = cKDTree(xy)
+        # the data in tree order, where a neighbourhood's indices lie close together (cache-
+        # friendly gathers); the tree keeps the given order, so ties break as they would
+        order = self.tree.indices
+        self.rank = np.empty(n, dtype=np.intp)
+        self.rank[order] = np.arange(n)
+        self.xy = xy[order]
+        self.z = z[order]
+        self.model = model
+        self.linear = linear
+        self.exact_at = exact_at
+        self.scale = scale
+        self.k = k
+        self.drift = _drift(self.xy, linear, scale)
+        # gather the systems from the data covariance matrix when it is small enough to hold
+        # and not much larger than the systems themselves
+        small = n <= _TABLE_MAX and n * n <= 2 * n_targets * k * k
+        self.table = _data_covariance(self.xy, model).reshape(-1) if small else None
+        # an order-free hash of a neighbour set: the wrapping sum of random 64-bit keys
+        self.keys: NDArray[np.uint64] = np.asarray(
+            np.random.default_rng(0).integers(0, 2**63, n, dtype=np.uint64)
+        )
+
+    def _covariance(self, members: NDArray[np.intp]) -> FloatArray:
+        """The covariance matrices ``(s, k, k)`` of neighbour sets ``(s, k)``."""
+        n = self.xy.shape[0]
+        if self.table is not None:
+            flat = members[:, :, None] * n + members[:, None, :]
+            return np.asarray(np.take(self.table, flat), dtype=np.float64)
+        p = self.xy[members]
+        dx = p[:, :, None, 0] - p[:, None, :, 0]
+        dy = p[:, :, None, 1] - p[:, None, :, 1]
+        cov = self.model.covariance(np.sqrt(dx * dx + dy * dy))
+        k = self.k
+        cov[:, np.arange(k), np.arange(k)] = self.model.sill
+        return cov
+
+    def block(self, targets: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Predictions and variances at ``targets (b, 2)``."""
+        b, k = targets.shape[0], self.k
+        distance, index = self.tree.query(targets, k=k)
+        distance = np.asarray(distance).reshape(b, k)
+        index = self.rank[np.asarray(index).reshape(b, k)]
+        order = np.argsort(index, axis=1)  # each set in a canonical order
+        index = np.take_along_axis(index, order, axis=1)
+        distance = np.take_along_axis(distance, order, axis=1)
+        key = np.asarray(np.sum(self.keys[index], axis=1, dtype=np.uint64))
+        _, first, group = np.unique(key, return_index=True, return_inverse=True)
+        group = group.reshape(-1)
+        if not np.array_equal(index[first][group], index):  # a hash collision: share nothing
+            first = group = np.arange(b)
+        members = index[first]
+        c0 = self.model.covariance(distance, exact_at=self.exact_at)
+        f0 = _drift(targets, self.linear, self.scale)
+        cov = self._covariance(members)
+        try:
+            lower = np.asarray(np.linalg.cholesky(cov), dtype=np.float64)
+            # per set: W = L⁻¹ F, u = L⁻¹ z, Q = Wᵀ W and h = Q⁻¹ Wᵀ u
+            solved = _forward(
+                lower, np.concatenate([self.drift[members], self.z[members, None]], 2)
+            )
+            m = self.drift.shape[1]
+            w, u = solved[:, :, :m], solved[:, :, m]
+            q_inverse = np.linalg.inv(np.einsum("skm,skn->smn", w, w))
+        except np.linalg.LinAlgError:  # not numerically positive definite: the bordered system
+            return self._bordered(index, c0, f0)
+        h = np.einsum("smn,skn,sk->sm", q_inverse, w, u)
+        # per target: r = L⁻¹ c₀, g = Wᵀ r − f₀
+        r = _forward(lower[group], c0)
+        g = np.einsum("bkm,bk->bm", w[group], r) - f0
+        prediction = np.einsum("bk,bk->b", r, u[group]) - np.einsum("bm,bm->b", g, h[group])
+        variance = (
+            self.model.sill
+            - np.einsum("bk,bk->b", r, r)
+            + np.einsum("bm,bmn,bn->b", g, q_inverse[group], g)
+        )
+        return prediction, variance
+
+    def _bordered(
+        self, index: NDArray[np.intp], c0: FloatArray, f0: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """One LU solve of the bordered system per target (PyKrige's system)."""
+        b, k = index.shape
+        m = self.drift.shape[1]
+        system = np.zeros((b, k + m, k + m))
+        system[:, :k, :k] = self._covariance(index)
+        system[:, :k, k:] = self.drift[index]
+        system[:, k:, :k] = self.drift[index].transpose(0, 2, 1)
+        rhs = np.concatenate([c0, f0], axis=1)
+        try:
+            solution = np.linalg.solve(system, rhs[:, :, None])[:, :, 0]
+        except np.linalg.LinAlgError as exc:
+            raise DegenerateGeometryError(
+                f"{LABEL}: a neighbourhood system is singular (duplicate points without a nugget, "
+                "or too few points for the drift); add a nugget, remove duplicates or use more "
+                "neighbours"
+            ) from exc
+        prediction = np.einsum("ij,ij->i", solution[:, :k], self.z[index])
+        return prediction, self.model.sill - np.einsum("ij,ij->i", solution, rhs)
+
+
 def _moving(
     xy: FloatArray,
     z: FloatArray,
@@ -159,44 +311,24 @@ def _moving(
     scale: float,
     k: int,
 ) -> tuple[FloatArray, FloatArray]:
-    n = xy.shape[0]
-    k = min(k, n)
-    tree = cKDTree(xy)
-    f_all = _drift(xy, linear, scale)
-    m = f_all.shape[1]
-    full = _data_covariance(xy, model).reshape(-1) if n <= 6000 else None
-    prediction = np.empty(targets.shape[0])
-    variance = np.empty(targets.shape[0])
-    for start in range(0, targets.shape[0], _LOCAL_BLOCK):
-        block = targets[start : start + _LOCAL_BLOCK]
-        distance, index = tree.query(block, k=k)
-        distance = distance.reshape(block.shape[0], k)
-        index = index.reshape(block.shape[0], k)
-        b = block.shape[0]
-        system = np.zeros((b, k + m, k + m))
-        if full is not None:  # flat gathers from the data covariance matrix
-            system[:, :k, :k] = np.take(full, index[:, :, None] * n + index[:, None, :])
+    t = targets.shape[0]
+    hood = _Neighbourhoods(xy, z, model, linear, exact_at, scale, min(k, xy.shape[0]), t)
+    prediction = np.empty(t)
+    variance = np.empty(t)
+
+    def run(start: int) -> None:
+        stop = start + _LOCAL_BLOCK
+        prediction[start:stop], variance[start:stop] = hood.block(targets[start:stop])
+
+    starts = range(0, t, _LOCAL_BLOCK)
+    workers = min(_workers(), len(starts))
+    with single_threaded_blas():  # threads over blocks instead
+        if workers > 1:
+            with ThreadPoolExecutor(workers) as pool:
+                list(pool.map(run, starts))
         else:
-            local = xy[index]
-            pair = np.linalg.norm(local[:, :, None, :] - local[:, None, :, :], axis=3)
-            system[:, :k, :k] = model.covariance(pair)
-            system[:, np.arange(k), np.arange(k)] = model.sill
-        system[:, :k, k:] = f_all[index]
-        system[:, k:, :k] = f_all[index].transpose(0, 2, 1)
-        rhs = np.empty((b, k + m))
-        rhs[:, :k] = model.covariance(distance, exact_at=exact_at)
-        rhs[:, k:] = _drift(block, linear, scale)
-        try:
-            with single_threaded_blas():
-                solution = np.linalg.solve(system, rhs[:, :, None])[:, :, 0]
-        except np.linalg.LinAlgError as exc:
-            raise DegenerateGeometryError(
-                f"{LABEL}: a neighbourhood system is singular (duplicate points without a nugget, "
-                "or too few points for the drift); add a nugget, remove duplicates or use more "
-                "neighbours"
-            ) from exc
-        prediction[start : start + b] = np.einsum("ij,ij->i", solution[:, :k], z[index])
-        variance[start : start + b] = model.sill - np.einsum("ij,ij->i", solution, rhs)
+            for start in starts:
+                run(start)
     return prediction, variance
 
 

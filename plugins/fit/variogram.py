@@ -59,6 +59,27 @@ def _structure(model: str, h: FloatArray, range_: float, nu: float) -> FloatArra
     raise OptionsError(f"unknown variogram model {model!r}; use one of {', '.join(MODELS)}")
 
 
+def _correlation(model: str, h: FloatArray, range_: float, nu: float) -> FloatArray:
+    """``1 − f(h)``, computed in place in one new array (the covariance is ``psill`` times it)."""
+    out = np.empty(np.shape(h))
+    if model == "spherical":
+        t = np.minimum(h, range_) / range_
+        np.multiply(t, t, out=out)  # 1 − 1.5 t + 0.5 t³ = 1 − t (1.5 − 0.5 t²)
+        out *= -0.5
+        out += 1.5
+        out *= t
+        return np.subtract(1.0, out, out=out)
+    if model == "exponential":
+        np.multiply(h, -3.0 / range_, out=out)
+        return np.exp(out, out=out)
+    if model == "gaussian":
+        np.multiply(h, h, out=out)
+        out *= -1.0 / (range_ * 4.0 / 7.0) ** 2
+        return np.exp(out, out=out)
+    out[...] = 1.0 - _structure(model, h, range_, nu)
+    return out
+
+
 @dataclass(frozen=True)
 class Variogram:
     """A bounded variogram: ``model``, total ``sill``, ``range``, ``nugget`` (Matérn ``nu``)."""
@@ -106,7 +127,8 @@ class Variogram:
         without it a target on a datum sees only the structured part (PyKrige's
         ``exact_values=False``).
         """
-        value = self.psill * (1.0 - _structure(self.model, h, self.range, self.nu))
+        value = _correlation(self.model, h, self.range, self.nu)
+        value *= self.psill
         if exact_at is not None:
             value = np.where(h <= exact_at, self.sill, value)
         return np.asarray(value)

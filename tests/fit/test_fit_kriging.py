@@ -5,11 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from fit_helpers import UTM
+from scipy.spatial import cKDTree
 
 import geobrep
 from geobrep import Surface
 from geobrep.errors import DegenerateGeometryError, OptionsError
 from geobrep.fitting import fit
+from geobrep.plugins.fit import kriging
 from geobrep.plugins.fit.kriging import krige
 from geobrep.plugins.fit.variogram import (
     Variogram,
@@ -55,6 +57,77 @@ def test_ordinary_kriging_matches_pykrige(model: str, data: tuple[np.ndarray, ..
     pred, var = krige(xy, z, nodes, variogram, n_closest_points=25)
     assert _relative(pred, z_near) <= 1e-6
     assert _relative(var, var_near) <= 1e-6
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_moving_neighbourhood_blocks_and_shared_sets_match_pykrige(
+    workers: int, data: tuple[np.ndarray, ...], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # a fine grid: many nodes share a neighbour set; small blocks put set groups and the datum
+    # on a node across block boundaries, on one thread or several
+    xy, z, _, _ = data
+    gx, gy = np.linspace(0, 1000, 61), np.linspace(-50, 1050, 57)
+    monkeypatch.setattr(kriging, "_LOCAL_BLOCK", 37)
+    monkeypatch.setattr(kriging, "_MAX_WORKERS", workers)
+    reference = pykrige_ok.OrdinaryKriging(
+        xy[:, 0], xy[:, 1], z, variogram_model="spherical", variogram_parameters=PARAMS
+    )
+    z_ref, var_ref = reference.execute("grid", gx, gy, backend="C", n_closest_points=12)
+    nodes = np.column_stack([np.tile(gx, gy.size), np.repeat(gy, gx.size)])
+    tree = cKDTree(xy)
+    sets = np.sort(tree.query(nodes, k=12)[1], axis=1)
+    assert np.unique(sets, axis=0).shape[0] < 0.7 * nodes.shape[0]  # sets are shared
+    pred, var = krige(
+        xy, z, nodes, variogram_from_options("spherical", PARAMS), n_closest_points=12
+    )
+    assert _relative(pred, z_ref) <= 1e-6
+    assert _relative(var, var_ref) <= 1e-6
+
+
+def test_moving_neighbourhood_hash_collisions_and_bordered_fallback(
+    data: tuple[np.ndarray, ...], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    xy, z, gx, gy = data
+    nodes = np.column_stack([np.tile(gx, gy.size), np.repeat(gy, gx.size)])
+    model = variogram_from_options("exponential", PARAMS)
+    expected = krige(xy, z, nodes, model, n_closest_points=20)
+    centred, where = xy - xy.mean(axis=0), nodes - xy.mean(axis=0)
+    hood = kriging._Neighbourhoods(centred, z, model, False, kriging.EPS, 500.0, 20, len(nodes))
+    hood.keys[:] = 0  # every set hashes alike: the exact check must refuse to share
+    collided = hood.block(where)
+    np.testing.assert_allclose(collided[0], expected[0], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(collided[1], expected[1], rtol=1e-9, atol=1e-12)
+
+    def not_positive(matrix: np.ndarray) -> np.ndarray:
+        raise np.linalg.LinAlgError("not positive definite")
+
+    # without a Cholesky factor, each target's bordered system is solved (PyKrige's way)
+    monkeypatch.setattr(kriging.np.linalg, "cholesky", not_positive)
+    bordered = krige(xy, z, nodes, model, n_closest_points=20)
+    np.testing.assert_allclose(bordered[0], expected[0], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(bordered[1], expected[1], rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("linear_drift", [False, True])
+def test_fewer_points_than_neighbours_is_the_global_system(
+    linear_drift: bool, data: tuple[np.ndarray, ...]
+) -> None:
+    xy, z, gx, gy = data
+    xy, z = xy[:18], z[:18]  # every target's neighbourhood is all the data: one shared set
+    nodes = np.column_stack([np.tile(gx, gy.size), np.repeat(gy, gx.size)])
+    model = variogram_from_options("gaussian", PARAMS)
+    pred, var = krige(xy, z, nodes, model, linear_drift=linear_drift)
+    near, near_var = krige(xy, z, nodes, model, n_closest_points=30, linear_drift=linear_drift)
+    assert _relative(near, pred) <= 1e-9
+    assert _relative(near_var, var) <= 1e-9
+
+
+def test_moving_neighbourhood_duplicates_without_nugget(data: tuple[np.ndarray, ...]) -> None:
+    xy, z, gx, gy = data
+    xy, z = np.vstack([xy, xy[:1]]), np.append(z, z[0] + 1.0)  # same place, other value
+    nodes = np.column_stack([np.tile(gx, gy.size), np.repeat(gy, gx.size)])
+    with pytest.raises(DegenerateGeometryError, match="duplicate"):
+        krige(xy, z, nodes, Variogram("spherical", 1.0, 300.0), n_closest_points=10)
 
 
 def test_universal_kriging_with_linear_drift_matches_pykrige(data: tuple[np.ndarray, ...]) -> None:
