@@ -50,6 +50,8 @@ from geobrep.fitting import FitReport, FitResult, fit
 from geobrep.geometry import BoundingBox, Plane
 from geobrep.io import read, write
 from geobrep.map_products import map_products
+from geobrep.pipeline import Pipeline
+from geobrep.pipeline_run import PipelineSummary, run_pipeline
 from geobrep.properties import Property
 from geobrep.scene import Group, Scene
 from geobrep.topology import Arc, Corner, Patch, Topology
@@ -85,6 +87,8 @@ __all__ = [
     "OptionsError",
     "Patch",
     "PatchSide",
+    "Pipeline",
+    "PipelineSummary",
     "Plane",
     "PluginError",
     "PointSet",
@@ -109,6 +113,7 @@ __all__ = [
     "map_products",
     "plugins",
     "read",
+    "run_pipeline",
     "section",
     "to_geodataframe",
     "voxelize",

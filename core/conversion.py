@@ -24,7 +24,7 @@ from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from os import PathLike
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict
 
@@ -32,10 +32,19 @@ from geobrep.capabilities import capability_losses
 from geobrep.errors import FileAccessError, GeobrepError, OptionsError
 from geobrep.io import read, write
 
-__all__ = ["ConversionSummary", "FileReport", "convert", "convert_file", "demo_stage", "expand"]
+__all__ = [
+    "ConversionSummary",
+    "FileReport",
+    "convert",
+    "convert_file",
+    "demo_stage",
+    "expand",
+    "run_each",
+]
 
 PathArg = str | PathLike[str]
 Progress = Callable[["FileReport", int, int], None]
+R = TypeVar("R")
 
 
 class FileReport(BaseModel):
@@ -238,62 +247,89 @@ def convert(
 
     indices = [i for i, t in enumerate(targets) if t is not None]
     arguments = [(s, t, read_format, write_format, write_options) for s, t in work]
-    if client is not None:
-        _run_dask(client, indices, arguments, done)
-    elif jobs > 1 and len(work) > 1:
-        _run_processes(jobs, indices, arguments, done)
-    else:
-        for index, args in zip(indices, arguments, strict=True):
-            done(index, convert_file(*args))
+
+    def finished(position: int, report: FileReport | None, error: BaseException | None) -> None:
+        if report is None:  # the worker died (killed, out of memory)
+            source, target = arguments[position][:2]
+            report = _failed(source, target, f"worker failed: {type(error).__name__}", 0.0)
+        done(indices[position], report)
+
+    run_each(convert_file, arguments, finished, jobs=jobs if len(work) > 1 else 1, client=client)
     return ConversionSummary(reports=tuple(results[i] for i in range(total)))
+
+
+def run_each(
+    function: Callable[..., R],
+    arguments: Sequence[tuple[Any, ...]],
+    done: Callable[[int, R | None, BaseException | None], None],
+    *,
+    jobs: int = 1,
+    client: Any = None,
+) -> None:
+    """Call ``function(*args)`` for every tuple of ``arguments``: here, in processes, or on Dask.
+
+    ``jobs > 1`` runs that many worker processes; ``client`` (a ``dask.distributed.Client`` or
+    a scheduler address) runs the calls on a Dask cluster. ``done(position, result, None)`` is
+    called as each call finishes, in completion order; ``done(position, None, error)`` when a
+    worker died under it. ``function`` should not raise: in this process an exception
+    propagates. Shared by :func:`convert` and :func:`geobrep.pipeline_run.run_pipeline`.
+    """
+    if client is not None:
+        _run_dask(client, function, arguments, done)
+    elif jobs > 1 and len(arguments) > 1:
+        _run_processes(jobs, function, arguments, done)
+    else:
+        for position, args in enumerate(arguments):
+            done(position, function(*args), None)
 
 
 def _run_processes(
     jobs: int,
-    indices: list[int],
-    arguments: list[tuple[Any, ...]],
-    done: Callable[[int, FileReport], None],
+    function: Callable[..., R],
+    arguments: Sequence[tuple[Any, ...]],
+    done: Callable[[int, R | None, BaseException | None], None],
 ) -> None:
     with ProcessPoolExecutor(max_workers=jobs) as pool:
         futures = {
-            pool.submit(convert_file, *args): (index, args)
-            for index, args in zip(indices, arguments, strict=True)
+            pool.submit(function, *args): position for position, args in enumerate(arguments)
         }
         for future in as_completed(futures):
-            index, args = futures[future]
+            position = futures[future]
             try:
-                report = future.result()
+                result = future.result()
             except Exception as exc:  # the worker process died (e.g. killed, out of memory)
-                report = _failed(args[0], args[1], f"worker failed: {type(exc).__name__}", 0.0)
-            done(index, report)
+                done(position, None, exc)
+            else:
+                done(position, result, None)
 
 
 def _run_dask(
     client: Any,
-    indices: list[int],
-    arguments: list[tuple[Any, ...]],
-    done: Callable[[int, FileReport], None],
+    function: Callable[..., R],
+    arguments: Sequence[tuple[Any, ...]],
+    done: Callable[[int, R | None, BaseException | None], None],
 ) -> None:
     try:
         distributed = importlib.import_module("distributed")
     except ImportError as exc:
         from geobrep.errors import MissingDependencyError
 
-        raise MissingDependencyError("distributed", "dask", "converting on a Dask cluster") from exc
+        raise MissingDependencyError("distributed", "dask", "running on a Dask cluster") from exc
     own = isinstance(client, str)
     active = distributed.Client(client) if own else client
     try:
         futures = {
-            active.submit(convert_file, *args, pure=False): (index, args)
-            for index, args in zip(indices, arguments, strict=True)
+            active.submit(function, *args, pure=False): position
+            for position, args in enumerate(arguments)
         }
         for future in distributed.as_completed(list(futures)):
-            index, args = futures[future]
+            position = futures[future]
             try:
-                report = future.result()
+                result = future.result()
             except Exception as exc:  # the worker died
-                report = _failed(args[0], args[1], f"worker failed: {type(exc).__name__}", 0.0)
-            done(index, report)
+                done(position, None, exc)
+            else:
+                done(position, result, None)
     finally:
         if own:
             active.close()

@@ -1,6 +1,7 @@
 """JSON Schemas generated from geobrep's pydantic models, and a loader.
 
-``scene.schema.json`` describes ``scene.json``, the document inside a native ``.geobrep`` file.
+``scene.schema.json`` describes ``scene.json``, the document inside a native ``.geobrep`` file;
+``pipeline.schema.json`` describes pipeline files (``geobrep run pipeline.yaml``).
 Regenerate after changing a model with ``make schemas`` (``python -m geobrep.schemas``); a test
 fails when the stored file is stale.
 
@@ -18,17 +19,22 @@ from typing import Any
 
 __all__ = ["SCHEMA_NAMES", "generate", "load", "write_all"]
 
-SCHEMA_NAMES = ("scene",)
+SCHEMA_NAMES = ("scene", "pipeline")
 
 
 def generate() -> dict[str, dict[str, Any]]:
     """Build every schema from the current models."""
     from geobrep.adapters.native.container import NativeDocument
+    from geobrep.pipeline import Pipeline
 
-    scene = NativeDocument.model_json_schema(mode="serialization")
-    scene["$schema"] = "https://json-schema.org/draft/2020-12/schema"
-    scene["$id"] = "https://geobrep.org/schemas/scene.schema.json"
-    return {"scene": scene}
+    schemas = {
+        "scene": NativeDocument.model_json_schema(mode="serialization"),
+        "pipeline": Pipeline.model_json_schema(mode="validation", by_alias=True),
+    }
+    for name, schema in schemas.items():
+        schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+        schema["$id"] = f"https://geobrep.org/schemas/{name}.schema.json"
+    return schemas
 
 
 def load(name: str) -> dict[str, Any]:

@@ -45,6 +45,8 @@ DOCTEST_MODULES = [
     "geobrep.crs_ops",
     "geobrep.feature_tables",
     "geobrep.map_products",
+    "geobrep.pipeline",
+    "geobrep.pipeline_run",
 ]
 
 #: Modules covered elsewhere (their own doctest runs belong to their suites).

@@ -11,9 +11,10 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any
+from pathlib import Path
+from typing import Any, Protocol
 
-from geobrep.conversion import ConversionSummary, FileReport, convert
+from geobrep.conversion import ConversionSummary, convert
 from geobrep.errors import OptionsError
 
 __all__ = ["add_parser", "run"]
@@ -56,6 +57,16 @@ def add_parser(subparsers: Any) -> None:
     parser.set_defaults(run=run)
 
 
+class Reported(Protocol):
+    """What the progress bar shows of a report (a conversion's or a pipeline's)."""
+
+    @property
+    def source(self) -> Path: ...
+
+    @property
+    def status(self) -> str: ...
+
+
 class ProgressBar:
     """A one-line progress bar on stderr (only drawn on a terminal unless forced)."""
 
@@ -63,11 +74,11 @@ class ProgressBar:
         self.enabled = enabled
         self.width = width
 
-    def __call__(self, report: FileReport, done: int, total: int) -> None:
+    def __call__(self, report: Reported, done: int, total: int) -> None:
         if not self.enabled:
             return
         filled = int(self.width * done / max(total, 1))
-        mark = "ok" if report.status == "converted" else "FAILED"
+        mark = "FAILED" if report.status == "failed" else "ok"
         name = report.source.name[-40:]
         sys.stderr.write(
             f"\r[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} {mark:6} {name:40}"

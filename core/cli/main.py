@@ -29,6 +29,7 @@ COMMAND_MODULES = (
     "blocks",
     "voxelize",
     "fit",
+    "run",
 )
 
 
