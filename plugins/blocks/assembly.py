@@ -36,9 +36,11 @@ class Assembly:
     scene: Scene
     removed_surfaces: list[str]
     internal_patches: list[int]
+    #: Soup vertex of every vertex of each rebuilt surface, by surface id.
+    vertex_ids: dict[int, IntArray]
 
 
-def _rebuilt_surface(soup: Soup, split: PatchSplit, index: int) -> Surface | None:
+def _rebuilt_surface(soup: Soup, split: PatchSplit, index: int) -> tuple[Surface, IntArray] | None:
     surface = soup.surfaces[index]
     rows = np.flatnonzero(soup.triangle_surface == index)
     if rows.size == 0:
@@ -56,18 +58,20 @@ def _rebuilt_surface(soup: Soup, split: PatchSplit, index: int) -> Surface | Non
     labels = split.patch_label[split.triangle_patch[rows]]
     n_labels = int(labels.max()) + 1
     name = surface.name or f"surface {surface.id}"
-    return Surface(
+    ids = vertex_map[kept]
+    rebuilt = Surface(
         id=surface.id,
         name=surface.name,
         kind=surface.kind,
         metadata=surface.metadata,
-        vertices=soup.vertices[vertex_map[kept]],
+        vertices=soup.vertices[ids],
         faces=rank[merged],
         patch_labels=labels,
         patch_names=tuple(f"{name}:{k}" for k in range(n_labels)),
         point_data=surface.point_data.take(kept),
         cell_data=surface.cell_data.take(soup.triangle_face[rows]),
     )
+    return rebuilt, ids
 
 
 def assemble(
@@ -81,9 +85,11 @@ def assemble(
 ) -> Assembly:
     """The scene with the built topology (blocks and topology of ``scene`` are replaced)."""
     built_ids = {int(s.id or 0) for s in soup.surfaces}
-    surfaces: dict[int, Surface | None] = {
+    results = {
         int(s.id or 0): _rebuilt_surface(soup, split, i) for i, s in enumerate(soup.surfaces)
     }
+    surfaces = {key: None if found is None else found[0] for key, found in results.items()}
+    vertex_ids = {key: found[1] for key, found in results.items() if found is not None}
     kept: list[Entity] = []
     for entity in scene.entities:
         if isinstance(entity, Block):
@@ -146,7 +152,7 @@ def assemble(
     groups = _groups(scene, {int(e.id or 0) for e in kept}, [int(b.id or 0) for b in blocks])
     internal = [p.id for p in topology.patches if p.is_internal]
     built = scene.replace(entities=(*kept, *blocks), topology=topology, groups=groups)
-    return Assembly(built, removed, internal)
+    return Assembly(built, removed, internal, vertex_ids)
 
 
 def _topology(

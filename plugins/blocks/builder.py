@@ -172,7 +172,7 @@ def build_blocks(scene: Scene, options: BlockBuilderOptions) -> Scene:
     validation = None
     if options.validate_blocks:
         with watch.stage("validation"):
-            validation = validate_scene(built)
+            validation = validate_scene(built, soup, split, measures, assembly.vertex_ids)
     report = BlockReport(
         surfaces=len(surfaces),
         triangles=n_input,

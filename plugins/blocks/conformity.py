@@ -40,6 +40,10 @@ FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
 _MAX_LISTED = 8
+#: Triangle pairs tested at once (bounds the (K, 3, 3, 3) temporaries).
+_BATCH = 1 << 15
+#: Corner j + 1 of corner j (edge j runs from one to the other).
+_NEXT = np.array([1, 2, 0])
 
 
 @dataclass(frozen=True)
@@ -165,8 +169,92 @@ def _segment_hits_triangle(
     return hits
 
 
+def _segment_pairs_hit(first: FloatArray, second: FloatArray, tol: float) -> BoolArray:
+    """The six edge–triangle tests of :func:`triangles_intersect`, one combination at a time."""
+    hits = np.zeros(first.shape[0], dtype=np.bool_)
+    for one, other in ((first, second), (second, first)):
+        a, b, c = other[:, 0], other[:, 1], other[:, 2]
+        for j in range(3):
+            todo = ~hits
+            if not todo.any():
+                return hits
+            p, q = one[todo, j], one[todo, (j + 1) % 3]
+            hits[todo] = _segment_hits_triangle(p, q, a[todo], b[todo], c[todo], tol)
+    return hits
+
+
+def _cross(u: FloatArray, v: FloatArray) -> FloatArray:
+    """Cross products along the last axis (broadcasting)."""
+    ux, uy, uz = u[..., 0], u[..., 1], u[..., 2]
+    vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx], axis=-1)
+
+
+def _any3(flags: BoolArray) -> BoolArray:
+    """``flags.any(axis=-1)`` for a last axis of 3 (column operations: much faster)."""
+    return np.asarray(flags[..., 0] | flags[..., 1] | flags[..., 2])
+
+
+def _all3(flags: BoolArray) -> BoolArray:
+    """``flags.all(axis=-1)`` for a last axis of 3."""
+    return np.asarray(flags[..., 0] & flags[..., 1] & flags[..., 2])
+
+
+def _edges_touching(one: FloatArray, other: FloatArray, tol: float) -> BoolArray:
+    """Whether an edge of each triangle ``one[k]`` meets triangle ``other[k]`` within ``tol``:
+    :func:`_segment_hits_triangle` for its three edges at once.
+
+    An edge crossing the plane (or ending within ``tol`` of it) meets the triangle where the
+    crossing point lies within ``tol`` inside each of its sides; an edge lying in the plane meets
+    it when an end lies inside or the edge comes within ``tol`` of a side."""
+    a = other[:, 0]
+    normal = _cross(other[:, 1] - a, other[:, 2] - a)
+    hits = np.zeros(one.shape[0], dtype=np.bool_)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        unit = normal / np.linalg.norm(normal, axis=1)[:, None]
+        height = np.matmul(one - a[:, None, :], unit[:, :, None])[:, :, 0]  # corners' heights
+        dp, dq = height, height[:, _NEXT]  # edge j runs from corner j to j + 1
+        on_p, on_q = np.abs(dp) <= tol, np.abs(dq) <= tol
+        coplanar = on_p & on_q
+        crossing = ~coplanar & ((dp * dq < 0.0) | on_p | on_q)
+        involved = crossing | coplanar
+        rows = np.flatnonzero(_any3(involved))
+        if rows.size == 0:
+            return hits
+        u = other[rows]
+        side = u[:, _NEXT] - u  # (K, side, xyz)
+        # In-plane inward normal of each side over its length: (x - u) . inward is how far
+        # inside that side a point of the plane lies.
+        inward = _cross(unit[rows][:, None, :], side) / np.linalg.norm(side, axis=2)[:, :, None]
+        base = np.einsum("ksj,ksj->ks", u, inward)
+        p = one[rows]
+        q = p[:, _NEXT]
+        dp, dq, on_p, on_q = dp[rows], dq[rows], on_p[rows], on_q[rows]
+        t = np.where(on_p, 0.0, np.where(on_q, 1.0, dp / (dp - dq)))
+        x = p + t[:, :, None] * (q - p)  # (K, edge, xyz)
+        reach = np.matmul(x, inward.transpose(0, 2, 1)) - base[:, None, :]  # (K, edge, side)
+        found = _any3(crossing[rows] & _all3(reach >= -tol))
+        flat = coplanar[rows]
+        if flat.any():
+            k, e = np.nonzero(flat)
+            ends = np.stack([p[k, e], q[k, e]], axis=1)  # (F, end, xyz)
+            reach = np.matmul(ends, inward[k].transpose(0, 2, 1)) - base[k][:, None, :]
+            inside = _all3(reach >= -tol)  # (F, end)
+            near = inside[:, 0] | inside[:, 1]
+            starts, stops = u[k].reshape(-1, 3), u[k][:, _NEXT].reshape(-1, 3)
+            gap = _segment_distance(
+                np.repeat(ends[:, 0], 3, axis=0), np.repeat(ends[:, 1], 3, axis=0), starts, stops
+            )
+            near |= _any3((gap <= tol).reshape(-1, 3))
+            found[k[near]] = True
+        hits[rows] = found
+    return hits
+
+
 def triangles_intersect(first: FloatArray, second: FloatArray, tol: float) -> BoolArray:
-    """Whether triangles ``first[i]`` and ``second[i]`` ((K, 3, 3) corners) meet within ``tol``.
+    """Whether triangles ``first[i]`` and ``second[i]`` ((K, 3, 3) corners) meet within ``tol``:
+    an edge of one crosses or touches the other (closed triangles), or, lying in the other's
+    plane, comes within ``tol`` of it.
 
     >>> import numpy as np
     >>> flat = np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0]]], dtype=float)
@@ -177,14 +265,11 @@ def triangles_intersect(first: FloatArray, second: FloatArray, tol: float) -> Bo
     [False]
     """
     hits = np.zeros(first.shape[0], dtype=np.bool_)
-    for one, other in ((first, second), (second, first)):
-        a, b, c = other[:, 0], other[:, 1], other[:, 2]
-        for j in range(3):
-            todo = ~hits
-            if not todo.any():
-                return hits
-            p, q = one[todo, j], one[todo, (j + 1) % 3]
-            hits[todo] = _segment_hits_triangle(p, q, a[todo], b[todo], c[todo], tol)
+    for start in range(0, first.shape[0], _BATCH):
+        one, other = first[start : start + _BATCH], second[start : start + _BATCH]
+        hits[start : start + _BATCH] = _edges_touching(one, other, tol) | _edges_touching(
+            other, one, tol
+        )
     return hits
 
 
