@@ -255,20 +255,25 @@ class _Neighbourhoods:
         c0 = self.model.covariance(distance, exact_at=self.exact_at)
         f0 = _drift(targets, self.linear, self.scale)
         cov = self._covariance(members)
+        m = self.drift.shape[1]
         try:
             lower = np.asarray(np.linalg.cholesky(cov), dtype=np.float64)
-            # per set: W = L⁻¹ F, u = L⁻¹ z, Q = Wᵀ W and h = Q⁻¹ Wᵀ u
-            solved = _forward(
-                lower, np.concatenate([self.drift[members], self.z[members, None]], 2)
-            )
-            m = self.drift.shape[1]
+            # per set: W = L⁻¹ F, u = L⁻¹ z, Q = Wᵀ W, h = Q⁻¹ Wᵀ u, and r = L⁻¹ c₀ for the
+            # target that represents the set
+            rhs = [self.drift[members], self.z[members, None], c0[first, :, None]]
+            solved = _forward(lower, np.concatenate(rhs, axis=2))
             w, u = solved[:, :, :m], solved[:, :, m]
             q_inverse = np.linalg.inv(np.einsum("skm,skn->smn", w, w))
         except np.linalg.LinAlgError:  # not numerically positive definite: the bordered system
             return self._bordered(index, c0, f0)
         h = np.einsum("smn,skn,sk->sm", q_inverse, w, u)
-        # per target: r = L⁻¹ c₀, g = Wᵀ r − f₀
-        r = _forward(lower[group], c0)
+        # per target: r = L⁻¹ c₀ (for the other targets of each set), g = Wᵀ r − f₀
+        r = np.empty((b, k))
+        r[first] = solved[:, :, m + 1]
+        others = np.ones(b, dtype=bool)
+        others[first] = False
+        if others.any():
+            r[others] = _forward(lower[group[others]], c0[others])
         g = np.einsum("bkm,bk->bm", w[group], r) - f0
         prediction = np.einsum("bk,bk->b", r, u[group]) - np.einsum("bm,bm->b", g, h[group])
         variance = (

@@ -91,6 +91,10 @@ def test_moving_neighbourhood_hash_collisions_and_bordered_fallback(
     nodes = np.column_stack([np.tile(gx, gy.size), np.repeat(gy, gx.size)])
     model = variogram_from_options("exponential", PARAMS)
     expected = krige(xy, z, nodes, model, n_closest_points=20)
+    # a few targets: the systems are built from the coordinates, not from the data covariance
+    few = krige(xy, z, nodes[:5], model, n_closest_points=20)
+    np.testing.assert_allclose(few[0], expected[0][:5], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(few[1], expected[1][:5], rtol=1e-9, atol=1e-9)
     centred, where = xy - xy.mean(axis=0), nodes - xy.mean(axis=0)
     hood = kriging._Neighbourhoods(centred, z, model, False, kriging.EPS, 500.0, 20, len(nodes))
     hood.keys[:] = 0  # every set hashes alike: the exact check must refuse to share
