@@ -87,8 +87,10 @@ def decode(raw: bytes) -> str:
 def _keyword_codes(source: Source) -> NDArray[np.int8]:
     """Per line: index + 1 of its bulk keyword in :data:`BULK_KEYWORDS`, or 0."""
     width = 7
-    buffer = np.frombuffer(source.data + b"\0" * width, dtype=np.uint8)
-    columns = [buffer[source.starts + k] for k in range(width)]  # one gather per byte
+    buffer = np.frombuffer(source.data, dtype=np.uint8)
+    # One gather per byte; past the end of the file the last byte repeats (a letter or a line
+    # break, never the space or tab that must follow a keyword).
+    columns = [np.take(buffer, source.starts + k, mode="clip") for k in range(width)]
     codes = np.zeros(source.n_lines, dtype=np.int8)
     for index, keyword in enumerate(BULK_KEYWORDS, start=1):
         match = np.ones(source.n_lines, dtype=bool)
@@ -189,9 +191,21 @@ def _renormalised(raw: bytes, keyword: bytes) -> bytes:
     return head + _normalised_body(raw, keyword).replace(b"\n", b"\n" + head)
 
 
-_TO_COMMAS = bytes.maketrans(b" \n", b",,")
-_NUMBER_BYTES = b"0123456789.+-eE \n"
-_INTEGER_BYTES = b"0123456789- \n"
+def _byte_map(kept: bytes, separators: bytes, separator: bytes) -> bytes:
+    """A ``bytes.translate`` table: ``kept`` bytes stay, ``separators`` become ``separator``
+    and every other byte ``!``, which no number parser accepts (odd content fails the parse)."""
+    table = bytearray(b"!" * 256)
+    for byte in kept:
+        table[byte] = byte
+    for byte in separators:
+        table[byte] = separator[0]
+    return bytes(table)
+
+
+#: Float runs become one JSON list: number bytes stay; blanks and line breaks are commas.
+_JSON_MAP = _byte_map(b"0123456789.+-eE", b" \t\n", b",")
+#: Integer runs stay blank-separated text for numpy (no sign but ``-``, no exponent).
+_INT_MAP = _byte_map(b"0123456789-", b" \t\n", b" ")
 _INT_LIMIT = 2**62
 
 
@@ -208,69 +222,111 @@ ORJSON = _load_orjson()
 
 
 def parse_run(source: Source, run: Run, integer: bool) -> NDArray[Any]:
-    """The numbers after the keyword of every line of ``run`` as a 2-D array.
+    """The numbers after the keyword of every line of ``run`` as a 2-D array (int64 when the
+    run holds integers only, else float64).
+
+    ``integer``: the run must hold integers only (ids).
 
     Raises :class:`BulkParseError` when the run holds anything but a rectangle of plain
     numbers (flags, odd spellings of infinity, ragged lines, a missing speed-up library), so
     that the caller parses it line by line with exact error messages.
+
+    The run is translated with numpy straight from :attr:`Source.data` (no copy of the text
+    first); a run this fast path rejects (repeated or trailing blanks) is rewritten with single
+    spaces and tried once more.
     """
     if ORJSON is None:
         raise BulkParseError
     keyword = run.keyword.encode()
-    raw = source.data[run.start : run.end]
-    if b"\t" in raw or raw.endswith(b" "):
-        raw = _renormalised(raw, keyword)
-    if raw.translate(None, _NUMBER_BYTES + keyword):
-        raise BulkParseError  # letters, flags, "inf", "1.#INF": only plain numbers go in bulk
-    buffer = np.frombuffer(raw, dtype=np.uint8)
-    newline = buffer == 10
-    separators = np.flatnonzero(newline | (buffer == 32))
-    if separators.size and (np.diff(separators) == 1).any():  # repeated or trailing spaces
-        raw = _renormalised(raw, keyword)
-        buffer = np.frombuffer(raw, dtype=np.uint8)
-        newline = buffer == 10
-        separators = np.flatnonzero(newline | (buffer == 32))
-    breaks = np.flatnonzero(newline[separators])
+    data = source.data
+    only_integers = (
+        data.find(b".", run.start, run.end) < 0
+        and data.find(b"e", run.start, run.end) < 0
+        and data.count(b"E", run.start, run.end) == run.count * keyword.count(b"E")
+    )
+    if integer and not only_integers:
+        raise BulkParseError  # "1.0", "1e0": the line parser says why they are no ids
+    starts = source.starts[run.first - 1 : run.first - 1 + run.count] - run.start
+    try:
+        return _parse_block(data, run.start, run.end, starts, len(keyword), only_integers)
+    except BulkParseError:
+        pass
+    raw = _renormalised(data[run.start : run.end], keyword)
+    breaks = np.flatnonzero(np.frombuffer(raw, dtype=np.uint8) == 10)
     if breaks.shape[0] != run.count - 1:
         raise BulkParseError
-    width = int(breaks[0]) if breaks.size else separators.shape[0]  # numbers per line
-    # Rectangular: every (width + 1)-th separator is a line break, and nothing else is.
-    if separators.shape[0] != run.count * (width + 1) - 1 or width == 0:
-        raise BulkParseError
-    if breaks.size and not np.array_equal(breaks, np.arange(width, separators.shape[0], width + 1)):
-        raise BulkParseError
-    # Every line starts with the keyword and one space (the first separator of the line).
-    starts = np.concatenate([[0], separators[breaks] + 1])
-    head = np.frombuffer(keyword + b" ", dtype=np.uint8)
-    if not (buffer[starts[:, None] + np.arange(head.shape[0])] == head).all():
-        raise BulkParseError
-    size = run.count * width
-    letters = bytes(set(keyword))
-    if len(raw) - len(raw.translate(None, letters)) != run.count * len(keyword):
-        raise BulkParseError  # keyword letters elsewhere than in the keywords ("3X")
-    if not raw.translate(None, _INTEGER_BYTES + keyword):  # integers only: numpy parses them
-        text = raw.translate(bytes.maketrans(letters, b" " * len(letters)))
-        try:
-            array = np.fromstring(text, dtype=np.int64, sep=" ")
-        except ValueError as exc:
-            raise BulkParseError from exc
-        if array.shape[0] != size or (array.size and np.abs(array).max() >= _INT_LIMIT):
-            raise BulkParseError  # a token numpy split or saturated: let the exact path decide
-        return array.reshape(run.count, width)
-    if integer:
-        raise BulkParseError
-    # JSON: separators become commas, the keyword and the space after it whitespace.
-    table = bytearray(_TO_COMMAS)
-    for letter in letters:
-        table[letter] = 32
-    json = bytearray(b"[") + raw.translate(bytes(table)) + b"]"
-    view = np.frombuffer(json, dtype=np.uint8)
-    view[starts + 1 + len(keyword)] = 32  # the byte after each keyword (offset 1 for "[")
+    starts = np.concatenate([[0], breaks + 1])
+    return _parse_block(raw, 0, len(raw), starts, len(keyword), only_integers)
+
+
+def _parse_block(
+    data: bytes, start: int, end: int, starts: NDArray[np.int64], skip: int, integers: bool
+) -> NDArray[Any]:
+    """Lines ``data[start:end]`` beginning at the offsets ``starts`` from ``start``, each a
+    keyword of ``skip`` bytes, a blank and numbers separated by single blanks."""
+    count = starts.shape[0]
+    heads = starts[:, None] + np.arange(skip + 1)  # each keyword and the blank after it
+    if integers:
+        return _parse_integers(data, start, end, heads, count)
+    # One copy of the run with a byte free at each end for the brackets, translated into a
+    # second, mutable one (bytes.translate is a plain table walk; numpy's take is slower).
+    text = bytearray(end - start + 2)
+    text[1:-1] = memoryview(data)[start:end]
+    json = text.translate(_JSON_MAP)
+    del text
+    json[0], json[-1] = ord("["), ord("]")
+    # Each keyword and its blank become a marker entry ("null", or "[]" after a 3-letter
+    # keyword; nothing else can produce either) that tells where the lines start.
+    marker: list[Any] | None = None if skip >= 4 else []
+    head = b"null," if marker is None else b"[],"
+    np.frombuffer(json, dtype=np.uint8)[1 + heads] = np.frombuffer(
+        head + b" " * (skip + 1 - len(head)), dtype=np.uint8
+    )
+    assert ORJSON is not None
     try:
-        flat = ORJSON.loads(json)
+        flat: list[Any] = ORJSON.loads(json)
+    except ValueError as exc:  # letters, flags, "inf", repeated blanks ("1,,2")
+        raise BulkParseError from exc
+    del json
+    step = len(flat) // count  # numbers per line + 1
+    # A rectangle: one marker per line and every step-th entry a marker, so every line has
+    # step - 1 numbers.
+    if step < 2 or step * count != len(flat) or flat[::step].count(marker) != count:
+        raise BulkParseError
+    del flat[::step]
+    try:
         array = np.fromiter(flat, dtype=np.float64, count=len(flat))
     except (ValueError, TypeError, OverflowError) as exc:
         raise BulkParseError from exc
-    if array.shape[0] != size:
+    return array.reshape(count, step - 1)
+
+
+def _parse_integers(
+    data: bytes, start: int, end: int, heads: NDArray[np.int64], count: int
+) -> NDArray[np.int64]:
+    """A run of integers (numpy's integer parser is faster than JSON's objects)."""
+    view = np.frombuffer(data, dtype=np.uint8, count=end - start, offset=start)
+    # A rectangle: as many blanks on every line, hence as many numbers once numpy (which
+    # would accept repeated ones) has read the right total.
+    blanks = np.flatnonzero(view == 32)
+    per_line = np.diff(np.searchsorted(blanks, heads[:, 0]), append=blanks.shape[0])
+    width = int(per_line[0])
+    if width == 0 or not (per_line == width).all():
         raise BulkParseError
-    return array.reshape(run.count, width)
+    if data.find(b"-", start, end) >= 0:  # numpy reads a lone "-" as 0
+        after = np.flatnonzero(view == 45) + 1
+        if after[-1] == view.shape[0]:
+            raise BulkParseError
+        digit = view[after]
+        if not ((digit >= 48) & (digit <= 57)).all():
+            raise BulkParseError
+    text = np.frombuffer(bytearray(memoryview(data)[start:end]).translate(_INT_MAP), np.uint8)
+    text[heads] = 32
+    try:
+        array = np.fromstring(text, dtype=np.int64, sep=" ")  # type: ignore[call-overload]
+    except ValueError as exc:  # numpy stopped before the end of the text
+        raise BulkParseError from exc
+    if array.shape[0] != count * width or (array.size and np.abs(array).max() >= _INT_LIMIT):
+        raise BulkParseError  # a token numpy split or saturated: let the exact path decide
+    result: NDArray[np.int64] = array.reshape(count, width)
+    return result

@@ -322,3 +322,27 @@ def test_garbled_bulk_values_never_parse_silently(tmp_path: Path) -> None:
         text = f"GOCAD VSet 1\nPROPERTIES a\nESIZES 1\n{rows.replace(' 0 0 7', f' 0 0 {bad}')}\nEND"
         with pytest.raises(geobrep.FormatError, match=r":11: PVRTX: .* is not a number"):
             geobrep.read(write(tmp_path, text, "bad.vs"))
+
+
+def test_bulk_runs_reject_what_a_number_parser_would_misread(tmp_path: Path) -> None:
+    vrtx = "\n".join(f"VRTX {k + 1} {k} 0 0" for k in range(10))
+    trgl = [f"TRGL {k + 1} {k + 2} {k + 3}" for k in range(8)]
+
+    def read(lines: list[str]) -> geobrep.Scene:
+        body = "\n".join(lines)
+        return geobrep.read(write(tmp_path, f"GOCAD TSurf 1\nTFACE\n{vrtx}\n{body}\nEND"))
+
+    for bad, token in (("TRGL 4 5 -", "-"), ("TRGL 4 5 true", "true")):  # numpy reads "-" as 0
+        with pytest.raises(geobrep.FormatError, match=f":16: TRGL: '{token}' is not an integer"):
+            read([*trgl[:3], bad, *trgl[4:]])
+    # One line too long, the next too short: the numbers are never shifted silently.
+    too_few = ":17: TRGL needs 3 vertex ids, found 2"
+    with (
+        pytest.warns(GocadWarning, match="extra entries"),
+        pytest.raises(geobrep.FormatError, match=too_few),
+    ):
+        read([*trgl[:3], "TRGL 4 5 6 7", "TRGL 5 6", *trgl[5:]])
+    spaced = "\n".join(f"VRTX  {k + 1}\t{k}.25  0 0 " for k in range(10))  # every line odd
+    text = f"GOCAD TSurf 1\nTFACE\n{spaced}\n" + "\n".join(trgl) + "\nEND"
+    surface = geobrep.read(write(tmp_path, text)).surfaces[0]
+    assert surface.vertices[:, 0].tolist() == [k + 0.25 for k in range(10)]
