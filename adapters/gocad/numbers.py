@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 from geobrep.adapters.gocad.lexer import ORJSON
 
-__all__ = ["format_float", "format_rows", "parse_float", "parse_int"]
+__all__ = ["format_float", "format_rows", "parse_float", "parse_int", "row_pieces"]
 
 _SPECIAL = {
     "inf": math.inf,
@@ -63,6 +63,102 @@ def format_float(value: float) -> str:
     return repr(float(value))
 
 
+def format_rows(prefix: bytes, ids: NDArray[np.int64] | None, values: NDArray[Any] | None) -> bytes:
+    """``prefix ids... values...`` lines (no final newline), one per row.
+
+    ``ids`` ((N,) or (N, k), written as integers) and ``values`` ((N, m): integers as
+    integers, floats with their shortest exact text) may each be None.
+
+    >>> format_rows(b"PVRTX", np.array([1, 2]), np.array([[0.5, 4.0], [1e-20, 3.0]]))
+    b'PVRTX 1 0.5 4\\nPVRTX 2 1e-20 3'
+    >>> format_rows(b"PVRTX", np.array([1, 2]), np.array([[0.5, -0.0], [1e-20, 3.0]]))
+    b'PVRTX 1 0.5 -0.0\\nPVRTX 2 1e-20 3.0'
+    >>> format_rows(b"TRGL", np.array([[1, 2, 3]]), np.array([[7.0]]))
+    b'TRGL 1 2 3 7'
+    """
+    return b"".join(row_pieces(prefix, ids, values))
+
+
+def row_pieces(
+    prefix: bytes, ids: NDArray[np.int64] | None, values: NDArray[Any] | None
+) -> list[bytes]:
+    """The text of :func:`format_rows` as pieces to concatenate (or write one after the other):
+    the first row's head, then the body, so that the body is never copied once more.
+
+    With orjson, a block is printed in one call and reshaped with three C-level passes over
+    the bytes: ``],[`` between rows becomes a line break, the next row's prefix and ``%d``
+    slots for its ids (filled by one ``%`` formatting), then commas become blanks and the
+    brackets go. Blocks whose values are all integers (ids, integral float properties) are
+    printed as integers, which read back as the same floats; so are integral floats elsewhere.
+    """
+    id_block, value_block = _columns(ids), _columns(values)
+    rows = id_block if id_block is not None else value_block
+    if rows is None or rows.shape[0] == 0:
+        return []
+    if value_block is not None:
+        integral = _as_integers(value_block)
+        if integral is not None:
+            value_block = None
+            id_block = (
+                integral
+                if id_block is None
+                else np.concatenate([id_block.astype(np.int64, copy=False), integral], axis=1)
+            )
+    if ORJSON is None or (value_block is not None and not np.isfinite(value_block).all()):
+        return [_format_slow(prefix, id_block, value_block)]
+    if value_block is None:
+        assert id_block is not None
+        block = np.ascontiguousarray(id_block, dtype=np.int64)
+        text = ORJSON.dumps(block, option=ORJSON.OPT_SERIALIZE_NUMPY)
+        body = text.replace(b"],[", b"\n" + prefix + b" ")
+        return [prefix + b" ", body.translate(_SPACES, b"[]")]
+    block = np.ascontiguousarray(value_block, dtype=np.float64)
+    text = ORJSON.dumps(block, option=ORJSON.OPT_SERIALIZE_NUMPY)
+    integral = (block == np.floor(block)).any(axis=0)
+    if integral.any() and not bool((np.signbit(block) & (block == 0)).any()):
+        # "2.0" → "2": the same float, shorter (-0.0 would lose its sign: then kept)
+        if integral[:-1].any():
+            text = text.replace(b".0,", b",")
+        if integral[-1]:
+            text = text.replace(b".0]", b"]")
+    if id_block is None:
+        body = text.replace(b"],[", b"\n" + prefix + b" ")
+        return [prefix + b" ", body.translate(_SPACES, b"[]")]
+    k = id_block.shape[1]
+    slots = b"\n" + prefix + b" %d" * k + b" "
+    head = b"%s %s " % (prefix, b" ".join(b"%d" % v for v in id_block[0].tolist()))
+    body = text.replace(b"],[", slots) % tuple(id_block[1:].ravel().tolist())
+    return [head, body.translate(_SPACES, b"[]")]
+
+
+_SPACES = bytes.maketrans(b",", b" ")
+
+
+def _columns(block: NDArray[Any] | None) -> NDArray[Any] | None:
+    """A (N,) or (N, k) block as (N, k); None when absent or without columns."""
+    if block is None:
+        return None
+    array = np.asarray(block)
+    if array.ndim == 1:
+        array = array[:, None]
+    return array if array.shape[1] else None
+
+
+def _as_integers(values: NDArray[Any]) -> NDArray[np.int64] | None:
+    """``values`` as int64 when every one is an integer that reads back as the same float64
+    (finite, integral, below 2**53, no -0.0); else None."""
+    if values.dtype.kind in "iub":
+        return values.astype(np.int64, copy=False)
+    if values.dtype.kind != "f":
+        return None
+    array = values.astype(np.float64, copy=False)
+    with np.errstate(invalid="ignore"):
+        integral = bool((np.abs(array) < 2**53).all() and (array == np.floor(array)).all())
+    if not integral or bool((np.signbit(array) & (array == 0)).any()):
+        return None
+    return array.astype(np.int64)
+
+
 def _column_texts(column: NDArray[Any]) -> list[bytes]:
     """One exact text per value of a 1-D numeric column."""
     if column.dtype.kind in "iub":
@@ -70,79 +166,19 @@ def _column_texts(column: NDArray[Any]) -> list[bytes]:
     return [repr(v).encode() for v in column.astype(np.float64).tolist()]
 
 
-def format_rows(prefix: bytes, ids: NDArray[np.int64] | None, values: NDArray[Any] | None) -> bytes:
-    """``prefix ids... values...`` lines (no final newline), one per row.
-
-    ``ids`` ((N,) or (N, k), written as integers) and ``values`` ((N, m): integers as
-    integers, floats with their shortest exact text) may each be None. With orjson installed,
-    finite blocks are formatted in one call (ids ride along as floats below 2**53, whose
-    shortest text is the integer itself once the ``.0`` is dropped).
-    """
-    blocks = []
-    for block in (ids, values):
-        if block is None:
-            continue
-        array = np.asarray(block)
-        if array.ndim == 1:
-            array = array.reshape(-1, 1)
-        if array.shape[1]:
-            blocks.append(array)
-    if not blocks or blocks[0].shape[0] == 0:
-        return b""
-    n = blocks[0].shape[0]
-    if len(blocks) == 2 and _fast_floats(blocks[1]) and np.abs(blocks[0]).max() < 2**53:
-        blocks = [np.concatenate([blocks[0].astype(np.float64), blocks[1]], axis=1)]
-    if len(blocks) == 1:
-        block = blocks[0]
-        if ORJSON is not None and (block.dtype.kind in "iub" or bool(np.isfinite(block).all())):
-            rows = _format_block(block, join=False)
-            return (prefix + b" " + rows.replace(b"],[", b"\n" + prefix + b" ")).translate(_SPACES)
-        return prefix + b" " + _format_block(block).replace(b"\n", b"\n" + prefix + b" ")
-    first = _format_block(blocks[0]).split(b"\n")
-    second = _format_block(blocks[1]).split(b"\n")
-    flat: list[bytes] = [b""] * (2 * n)
-    flat[0::2] = first
-    flat[1::2] = second
-    text: bytes = (prefix + b" %s %s\n") * n % tuple(flat)
-    return text[:-1]
-
-
-_SPACES = bytes.maketrans(b",", b" ")
-
-
-def _fast_floats(values: NDArray[Any]) -> bool:
-    """Float values orjson can print whose integral members may drop their ``.0``."""
-    return (
-        ORJSON is not None
-        and values.dtype.kind == "f"
-        and bool(np.isfinite(values).all())
-        and not bool((np.signbit(values) & (values == 0)).any())
-    )
-
-
-def _format_block(values: NDArray[Any], join: bool = True) -> bytes:
-    """Rows of space-separated numbers joined by newlines (``join=False``: orjson's rows,
-    comma-separated and joined by ``],[``, for the caller to finish)."""
-    if values.shape[1] == 0:
-        return b"\n" * (int(values.shape[0]) - 1)
-    integer = values.dtype.kind in "iub"
-    if ORJSON is not None and (integer or bool(np.isfinite(values).all())):
-        array = values.astype(np.int64 if integer else np.float64, copy=False)
-        text: bytes = ORJSON.dumps(np.ascontiguousarray(array), option=ORJSON.OPT_SERIALIZE_NUMPY)
-        if not integer and _fast_floats(array) and bool((array == np.floor(array)).any()):
-            # "2.0" → "2": the same float, shorter, and integer-only lines parse faster
-            text = text.replace(b".0,", b",").replace(b".0]", b"]")
-        text = text[2:-2]
-        if not join:
-            return text
-        return text.replace(b"],[", b"\n").translate(_SPACES)
-    if not join:
-        raise ValueError("unjoined rows need orjson and finite values")
-    columns = [_column_texts(values[:, j]) for j in range(values.shape[1])]
+def _format_slow(prefix: bytes, ids: NDArray[Any] | None, values: NDArray[Any] | None) -> bytes:
+    """Rows one number at a time (non-finite values, or no orjson): exact, slower."""
+    columns = [
+        _column_texts(block[:, j])
+        for block in (ids, values)
+        if block is not None
+        for j in range(block.shape[1])
+    ]
     k = len(columns)
-    flat: list[bytes] = [b""] * (k * values.shape[0])
-    for j, texts in enumerate(columns):
-        flat[j::k] = texts
-    line = b" ".join([b"%s"] * k) + b"\n"
-    block: bytes = line * values.shape[0] % tuple(flat)
-    return block[:-1]
+    n = len(columns[0])
+    flat: list[bytes] = [prefix] * ((k + 1) * n)
+    for j, texts in enumerate(columns, start=1):
+        flat[j :: k + 1] = texts
+    line = b" ".join([b"%s"] * (k + 1)) + b"\n"
+    text: bytes = line * n % tuple(flat)
+    return text[:-1]

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.gocad.headers import color_from_text, quote, quote_rest
-from geobrep.adapters.gocad.numbers import format_float, format_rows
+from geobrep.adapters.gocad.numbers import format_float, row_pieces
 from geobrep.adapters.gocad.parser import GocadWarning
 from geobrep.crs import CRS
 from geobrep.entities import Entity
@@ -307,10 +307,11 @@ class VertexWriter:
         self.has_values = values.shape[1] > 0
         self.atom_keyword = ("P" + atom_keyword if self.has_values else atom_keyword).encode()
 
-    def lines(self, lo: int, hi: int) -> bytes:
-        """The lines of vertices ``lo .. hi - 1`` (ids ``lo + 1 ..``), no final newline."""
+    def lines(self, lo: int, hi: int) -> list[bytes]:
+        """The lines of vertices ``lo .. hi - 1`` (ids ``lo + 1 ..``) as pieces to concatenate
+        (see :func:`~geobrep.adapters.gocad.numbers.row_pieces`), no final newline."""
         if hi <= lo:
-            return b""
+            return []
         atoms = self.atoms[lo:hi]
         is_atom = atoms >= 0
         pieces: list[bytes] = []
@@ -319,38 +320,45 @@ class VertexWriter:
         for a, b in zip(np.r_[0, cuts].tolist(), np.r_[cuts, hi - lo].tolist(), strict=True):
             ids = np.arange(lo + a + 1, lo + b + 1, dtype=np.int64)
             values = self.values[lo + a : lo + b] if self.has_values else None
+            if pieces:
+                pieces.append(b"\n")
             if is_atom[a]:
                 refs = atoms[a:b] + 1
-                pieces.append(format_rows(self.atom_keyword, np.column_stack([ids, refs]), values))
+                pieces += row_pieces(self.atom_keyword, np.column_stack([ids, refs]), values)
             else:
                 data = self.xyz[lo + a : lo + b]
                 if values is not None:
                     data = np.concatenate([data, values], axis=1)
-                pieces.append(format_rows(keyword, ids, data))
-        text = b"\n".join(pieces)
+                pieces += row_pieces(keyword, ids, data)
         if self.flags is not None:
             flags = np.asarray(self.flags[lo:hi])
             if flags.any():
-                rows = text.split(b"\n")
+                rows = b"".join(pieces).split(b"\n")
                 for i in np.flatnonzero(flags).tolist():
                     rows[i] += _FLAG_TEXT.get(int(flags[i]), b"")
-                text = b"\n".join(rows)
-        return text
+                pieces = [b"\n".join(rows)]
+        return pieces
 
 
 class ObjectText:
-    """Accumulates the lines of one object as bytes."""
+    """Accumulates the lines of one object as bytes, joined once at the end."""
 
     def __init__(self) -> None:
         self.parts: list[bytes] = []
 
     def add(self, *lines: str) -> None:
         for line in lines:
-            self.parts.append(line.encode("utf-8"))
+            self.parts += (line.encode("utf-8"), b"\n")
 
     def add_bytes(self, block: bytes) -> None:
+        """Lines of text (no final newline)."""
         if block:
-            self.parts.append(block)
+            self.parts += (block, b"\n")
+
+    def add_pieces(self, pieces: list[bytes]) -> None:
+        """Lines of text given as pieces to concatenate (no final newline)."""
+        if pieces:
+            self.parts += (*pieces, b"\n")
 
     def text(self) -> bytes:
-        return b"\n".join(self.parts) + b"\n"
+        return b"".join(self.parts)

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.gocad.headers import quote_rest
-from geobrep.adapters.gocad.numbers import format_float, format_rows
+from geobrep.adapters.gocad.numbers import format_float, format_rows, row_pieces
 from geobrep.adapters.gocad.objects import (
     CTETRA_PROPERTY,
     FLAG_PROPERTY,
@@ -139,16 +139,13 @@ class _Writer:
         for part in range(n_parts):
             name = surface.patch_name(part)
             out.add("TFACE" if name == str(part) else f"TFACE {name}")
-            out.add_bytes(vw.lines(int(starts[part]), int(starts[part + 1])))
+            out.add_pieces(vw.lines(int(starts[part]), int(starts[part + 1])))
             lo, hi = int(bounds[part]), int(bounds[part + 1])
-            block = faces[lo:hi] + 1
-            if cell_values is not None:
-                out.add_bytes(_with_values(b"TRGL", block, cell_values[lo:hi]))
-            else:
-                out.add_bytes(format_rows(b"TRGL", None, block))
+            values = cell_values[lo:hi] if cell_values is not None else None
+            out.add_pieces(row_pieces(b"TRGL", faces[lo:hi] + 1, values))
         if n_parts == 0:
             out.add("TFACE")
-            out.add_bytes(vw.lines(0, surface.n_vertices))
+            out.add_pieces(vw.lines(0, surface.n_vertices))
         self.borders(out, surface)
         self.tail(out, surface)
         return out.text()
@@ -212,15 +209,13 @@ class _Writer:
         for k in range(n_ilines):
             name = names[k] if k < len(names) and names[k] else ""
             out.add(f"ILINE {name}".rstrip())
-            out.add_bytes(vw.lines(int(starts[k]), int(starts[k + 1])))
+            out.add_pieces(vw.lines(int(starts[k]), int(starts[k + 1])))
             lo, hi = int(bounds[k]), int(bounds[k + 1])
-            if cell_values is not None:
-                out.add_bytes(_with_values(b"SEG", segments[lo:hi] + 1, cell_values[lo:hi]))
-            else:
-                out.add_bytes(format_rows(b"SEG", None, segments[lo:hi] + 1))
+            values = cell_values[lo:hi] if cell_values is not None else None
+            out.add_pieces(row_pieces(b"SEG", segments[lo:hi] + 1, values))
         if n_ilines == 0:
             out.add("ILINE")
-            out.add_bytes(vw.lines(0, line.n_points))
+            out.add_pieces(vw.lines(0, line.n_points))
         self.tail(out, line)
         return out.text()
 
@@ -237,7 +232,7 @@ class _Writer:
         for k in range(len(bounds) - 1):
             if cuts:
                 out.add("SUBVSET")
-            out.add_bytes(vw.lines(bounds[k], bounds[k + 1]))
+            out.add_pieces(vw.lines(bounds[k], bounds[k + 1]))
         self.tail(out, points)
         return out.text()
 
@@ -267,14 +262,10 @@ class _Writer:
         for part in range(n_parts):
             name = names[part]
             out.add(f"TVOLUME {name}".rstrip() if name != str(part) else "TVOLUME")
-            out.add_bytes(vw.lines(int(starts[part]), int(starts[part + 1])))
+            out.add_pieces(vw.lines(int(starts[part]), int(starts[part + 1])))
             lo, hi = int(bounds[part]), int(bounds[part + 1])
-            block = cells[lo:hi] + 1
-            text = (
-                _with_values(b"TETRA", block, cell_values[lo:hi])
-                if cell_values is not None
-                else format_rows(b"TETRA", None, block)
-            )
+            values = cell_values[lo:hi] if cell_values is not None else None
+            text = format_rows(b"TETRA", cells[lo:hi] + 1, values)
             if ctetra is not None and text:
                 rows = text.split(b"\n")
                 text = b"\n".join(r + b"\n" + c for r, c in zip(rows, ctetra[lo:hi], strict=True))
@@ -352,7 +343,7 @@ class _Writer:
                 if key is not None and 0 <= key < surface.n_faces:
                     a, b, c = (mapping[surface.faces[key]] + 1).tolist()[:3]
                     out.add(f"KEYVERTICES {a} {b} {c}")
-                out.add_bytes(format_rows(b"TRGL", None, mapping[surface.faces[faces]] + 1))
+                out.add_pieces(row_pieces(b"TRGL", mapping[surface.faces[faces]] + 1, None))
         for name, signed in regions:
             out.add(f"MODEL_REGION {name} {int(signed):+d}")
 
@@ -593,10 +584,6 @@ def _triangles(surface: Surface) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         return faces, np.arange(faces.shape[0], dtype=np.int64)
     triangles = np.stack([faces[:, [0, 1, 2]], faces[:, [0, 2, 3]]], axis=1).reshape(-1, 3)
     return triangles, np.repeat(np.arange(faces.shape[0], dtype=np.int64), 2)
-
-
-def _with_values(keyword: bytes, ids: NDArray[np.int64], values: NDArray[Any]) -> bytes:
-    return format_rows(keyword, ids, values)
 
 
 def write_gocad(scene: Scene, path: Path, options: GocadOptions | None = None) -> None:

@@ -175,3 +175,36 @@ def test_nothing_to_write_is_an_error_and_leaves_no_file(tmp_path: Path) -> None
     with pytest.warns(GocadWarning), pytest.raises(geobrep.FormatError, match="no Surface"):
         geobrep.write(scene, tmp_path / "empty.ts")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_awkward_floats_survive_the_bulk_paths_bit_for_bit(tmp_path: Path) -> None:
+    rng = np.random.default_rng(3)
+    n = 300
+    vertices = rng.normal(0.0, 1e6, (n, 3))
+    vertices[::7] = np.round(vertices[::7])  # integral coordinates: written as integers
+    vertices[50] = [-0.0, 0.0, 2.0**60]  # after the PATOM: a bulk run with no nan
+    vertices[60] = [5e-324, 1.7976931348623157e308, -1e-300]
+    vertices[40] = vertices[3]  # a repeated position: written as PATOM
+    values = rng.normal(size=(n, 2))
+    values[::5, 0] = 3.0
+    values[55, 1] = -0.0
+    values[9] = [np.nan, -0.0]  # before it: parsed line by line
+    values[10] = [np.inf, -np.inf]
+    faces = np.stack([np.arange(n - 2), np.arange(1, n - 1), np.arange(2, n)], axis=1)
+    cell = np.where(np.arange(n - 2) % 3 == 0, -0.0, rng.normal(size=n - 2))
+    surface = Surface(
+        vertices=vertices,
+        faces=faces,
+        name="awkward",
+        point_data={"a": values[:, 0], "b": values[:, 1]},
+        cell_data={"c": cell, "zone": (np.arange(n - 2) % 4).astype(np.float64)},
+    )
+    path = write_quietly(Scene(entities=[surface]), tmp_path / "awkward.ts")
+    assert "PATOM 41 4" in path.read_text()
+    back = read_quietly(path).surfaces[0]
+    assert arrays_identical(back.vertices, vertices)
+    assert np.array_equal(back.faces, faces)
+    for name, expected in (("a", values[:, 0]), ("b", values[:, 1])):
+        assert arrays_identical(back.point_data[name].values, expected)
+    for name in ("c", "zone"):
+        assert arrays_identical(back.cell_data[name].values, surface.cell_data[name].values)
