@@ -13,13 +13,15 @@ two vertex properties (a scalar and a 3-vector) and one triangle property. Two v
 For each variant the script writes the file with ``geobrep.write`` (timed), reads it back with
 ``geobrep.read`` (timed, and checked bit for bit), and reads the same file with
 ``opengeode-geosciencesio`` (``opengeode.load_triangulated_surface3D``) in the same run. Times
-are the best of ``--repeat`` runs; the machine is shared, so the ratio is the figure to trust.
+are the best and median of ``--repeat`` runs; on a shared machine the ratio is the figure to
+trust.
 Targets: read ≤ 1.5 s and ≤ 3× OpenGeode, write ≤ 1.5 s.
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
 import tempfile
 import time
 import warnings
@@ -65,13 +67,14 @@ def grid_surface(size: int, variant: str) -> Surface:
     )
 
 
-def best_of(repeat: int, function: Callable[[], Any]) -> tuple[float, Any]:
-    best, result = float("inf"), None
+def best_of(repeat: int, function: Callable[[], Any]) -> tuple[float, float, Any]:
+    """Best and median time of ``repeat`` runs, and the last result."""
+    times, result = [], None
     for _ in range(repeat):
         start = time.perf_counter()
         result = function()
-        best = min(best, time.perf_counter() - start)
-    return best, result
+        times.append(time.perf_counter() - start)
+    return min(times), statistics.median(times), result
 
 
 def opengeode_reader() -> Callable[[Path], Any] | None:
@@ -99,8 +102,8 @@ def run(size: int, repeat: int) -> None:
         path = folder / f"grid_{variant}.ts"
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            write_s, _ = best_of(repeat, lambda s=scene, p=path: geobrep.write(s, p))
-            read_s, again = best_of(repeat, lambda p=path: geobrep.read(p))
+            write_s, write_med, _ = best_of(repeat, lambda s=scene, p=path: geobrep.write(s, p))
+            read_s, read_med, again = best_of(repeat, lambda p=path: geobrep.read(p))
         back = again.surfaces[0]
         exact = (
             np.array_equal(back.vertices, surface.vertices)
@@ -112,13 +115,17 @@ def run(size: int, repeat: int) -> None:
         )
         size_mb = path.stat().st_size / 1e6
         line = (
-            f"  {variant:4}  file {size_mb:6.1f} MB   geobrep write {write_s:6.3f} s   "
-            f"geobrep read {read_s:6.3f} s   bit-identical={exact}"
+            f"  {variant:4}  file {size_mb:5.1f} MB  geobrep write {write_s:5.3f} s "
+            f"(median {write_med:5.3f})  read {read_s:5.3f} s (median {read_med:5.3f})  "
+            f"bit-identical={exact}"
         )
         if opengeode_read is not None:
-            og_s, mesh = best_of(repeat, lambda p=path: opengeode_read(p))
+            og_s, og_med, mesh = best_of(repeat, lambda p=path: opengeode_read(p))
             assert mesh.nb_polygons() == surface.n_faces
-            line += f"   OpenGeode read {og_s:6.3f} s   ratio read/OpenGeode {read_s / og_s:4.2f}"
+            line += (
+                f"\n        OpenGeode read {og_s:5.3f} s (median {og_med:5.3f})  "
+                f"ratio read/OpenGeode best {read_s / og_s:4.2f}, median {read_med / og_med:4.2f}"
+            )
         else:
             line += "   (opengeode-geosciencesio not installed)"
         print(line)
