@@ -98,8 +98,8 @@ class StepOptions(BaseModel):
 
 class ReadStep(StepOptions):
     """Read the input file: ``format`` names a registered format (default: from the extension
-    and content; ``.csv``/``.txt``/``.xyz``/``.dat`` points that no format claims are read as
-    ``x, y, z`` columns); ``options`` are that format's options. Optional; if present, first."""
+    and content; points tables ``.csv``/``.xyz``/``.txt``/``.dat`` are the ``csv`` format);
+    ``options`` are that format's options. Optional; if present, first."""
 
     kind: ClassVar[str] = "read"
 

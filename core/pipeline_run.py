@@ -71,7 +71,6 @@ PathArg = str | PathLike[str]
 Progress = Callable[["PipelineFileReport", int, int], None]
 
 #: Extensions read as ``x, y, z`` point columns when no registered format claims them.
-POINT_TABLE_EXTENSIONS = (".csv", ".txt", ".xyz", ".dat")
 
 
 class StepReport(BaseModel):
@@ -366,15 +365,7 @@ Applied = tuple[Scene, list[str]]
 
 
 def _read(step: ReadStep, scene: Scene, work: _Work) -> Applied:
-    source = work.source
-    table = step.format is None and source.suffix.lower() in POINT_TABLE_EXTENSIONS
-    if table and not work.registries.formats.for_extension(source.suffix):
-        from geobrep.cli.fit import read_points_csv
-
-        if not source.is_file():
-            raise FileAccessError("no such file", source)
-        return Scene(entities=[read_points_csv(source)], name=source.stem), []
-    return read(source, format=step.format, **step.options), []
+    return read(work.source, format=step.format, **step.options), []
 
 
 def _reproject(step: ReprojectStep, scene: Scene, work: _Work) -> Applied:

@@ -12,20 +12,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from geobrep.entities import Entity, NurbsSurface, PointSet, PolyLine
 from geobrep.errors import FileAccessError, FormatError, OptionsError
-from geobrep.properties import Property
 
-__all__ = ["add_parser", "read_points_csv", "run"]
+__all__ = ["add_parser", "run"]
 
 EXIT_NOT_MET = 3
-_SPLIT = re.compile(r"[,;\s]+")
 
 
 def add_parser(subparsers: Any) -> None:
@@ -59,81 +54,11 @@ def add_parser(subparsers: Any) -> None:
     parser.set_defaults(run=run)
 
 
-def _numbers(line: str) -> list[str]:
-    return [token for token in _SPLIT.split(line.strip()) if token]
-
-
-def read_points_csv(path: Path) -> PointSet:
-    """Points from a delimited text file: x, y, z (and more numeric columns as properties).
-
-    A first line that is not numeric is a header; columns named x, y, z (any case) are used when
-    present, otherwise the first three. Raises FormatError with the line of the first bad row.
-    """
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except OSError as exc:
-        raise FileAccessError(f"cannot be read ({exc.strerror or exc})", path) from exc
-    lines = [(number, line) for number, line in enumerate(text.splitlines(), 1) if line.strip()]
-    lines = [(n, line) for n, line in lines if not line.lstrip().startswith("#")]
-    if not lines:
-        raise FormatError("no points in the file", path)
-    header: list[str] | None = None
-    first = _numbers(lines[0][1])
-    try:
-        [float(token) for token in first]
-    except ValueError:
-        header = [token.strip().strip('"').lower() for token in first]
-        lines = lines[1:]
-    if not lines:
-        raise FormatError("the file has a header but no points", path)
-    width = len(_numbers(lines[0][1]))
-    joined = "\n".join(line for _, line in lines)
-    try:
-        rows = np.array(_SPLIT.split(joined.strip()), dtype=np.float64)
-        if rows.size != len(lines) * width:
-            raise ValueError("ragged rows")
-        rows = rows.reshape(len(lines), width)
-    except ValueError:
-        for number, line in lines:
-            tokens = _numbers(line)
-            if len(tokens) != width:
-                raise FormatError(
-                    f"expected {width} values, found {len(tokens)}", path, number
-                ) from None
-            try:
-                [float(token) for token in tokens]
-            except ValueError as exc:
-                raise FormatError(f"not a number: {exc}", path, number) from None
-        raise FormatError("cannot parse the points", path) from None
-    if width < 3:
-        raise FormatError(f"need x, y, z columns, found {width}", path, lines[0][0])
-    names = header if header is not None and len(header) == width else None
-    if names is not None and {"x", "y", "z"} <= set(names):
-        xyz = [names.index("x"), names.index("y"), names.index("z")]
-    else:
-        xyz = [0, 1, 2]
-    bad = ~np.isfinite(rows[:, xyz]).all(axis=1)
-    if bad.any():
-        number = lines[int(np.argmax(bad))][0]
-        raise FormatError("coordinates must be finite (NaN or inf found)", path, number)
-    extra = {}
-    for column in range(width):
-        if column in xyz:
-            continue
-        name = names[column] if names is not None else f"column_{column + 1}"
-        extra[name] = Property(values=rows[:, column])
-    return PointSet(vertices=rows[:, xyz], point_data=extra, name=path.stem)
-
-
 def _load_points(path: Path, fmt: str | None, entity: str | None) -> PointSet | PolyLine:
     from geobrep.io import read
-    from geobrep.plugins import registries
 
     if not path.exists():
         raise FileAccessError("no such file", path)
-    claimed = registries().formats.for_extension(path.suffix) if path.suffix else []
-    if fmt is None and not claimed and path.suffix.lower() in (".csv", ".txt", ".xyz", ".dat"):
-        return read_points_csv(path)
     scene = read(path, format=fmt)
     candidates: list[Entity] = [e for e in scene.entities if isinstance(e, PointSet | PolyLine)]
     if entity is not None:

@@ -11,7 +11,6 @@ import pytest
 import geobrep
 from geobrep import NurbsSurface, PointSet, Scene
 from geobrep.cli import main
-from geobrep.cli.fit import read_points_csv
 from geobrep.demo import DemoContext
 from geobrep.errors import EntityValidationError, FormatError, OptionsError, PluginError
 from geobrep.fitting import FitReport, FitResult, demo_stage, fit
@@ -210,12 +209,12 @@ class TestCommandLine:
     def test_csv_without_header(self, tmp_path: Path) -> None:
         path = tmp_path / "p.txt"
         path.write_text("# comment\n1 2 3 9\n4;5;6;9\n\n7,8,9,9\n")
-        points = read_points_csv(path)
+        points = geobrep.read(path).point_sets[0]
         np.testing.assert_array_equal(points.vertices[:, 0], [1.0, 4.0, 7.0])
         assert list(points.point_data) == ["column_4"]
         (tmp_path / "two.csv").write_text("1,2\n3,4\n")
         with pytest.raises(FormatError, match="need x, y, z"):
-            read_points_csv(tmp_path / "two.csv")
+            geobrep.read(tmp_path / "two.csv")
 
 
 def test_demo_stage(tmp_path: Path, layer_cake: Scene) -> None:

@@ -15,7 +15,7 @@ from geobrep.registry import FormatCapabilities
 from geobrep.scene import Scene
 
 #: Formats the meshio, ply and pyvista adapters (and the native format) register.
-OUR_FORMATS = ("native", "vtu", "vtk", "gmsh", "obj", "stl", "off", "ply", "vtp")
+OUR_FORMATS = ("native", "vtu", "vtk", "gmsh", "obj", "stl", "off", "ply", "vtp", "csv")
 
 
 def rich_scene() -> Scene:
