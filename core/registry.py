@@ -241,6 +241,9 @@ class FormatSpec(RegisteredItem):
     writer: Callable[..., Any] | None = None
     sniff: Callable[[bytes], bool] | None = None
     capabilities: FormatCapabilities = FormatCapabilities()
+    generic_content: bool = False
+    """The sniffer recognises generic content (e.g. rows of plain numbers): the format is
+    chosen by content only when no other format's sniffer recognises the file."""
 
     @field_validator("extensions", mode="before")
     @classmethod
@@ -478,7 +481,8 @@ class FormatRegistry(Registry[FormatSpec]):
 
         An explicit ``format`` name wins; otherwise the longest matching extension, with
         sniffing of the first :data:`SNIFF_BYTES` bytes to decide between several formats
-        or when no extension matches.
+        or when no extension matches (formats with ``generic_content`` only when no other
+        sniffer recognises the file).
 
         Raises:
             UnknownFormatError: nothing matches, or several formats match equally.
@@ -493,6 +497,9 @@ class FormatRegistry(Registry[FormatSpec]):
         head = _read_head(path)
         pool = candidates or readers
         sniffed = [spec for spec in pool if self._sniffs(spec, head)]
+        specific = [spec for spec in sniffed if not spec.generic_content]
+        if specific and len(specific) < len(sniffed):
+            sniffed = specific  # a format that knows this content beats a generic one
         if len(sniffed) == 1:
             return sniffed[0]
         if sniffed or candidates:

@@ -84,5 +84,6 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
             sniff=_sniff,
             options=CsvOptions,
             capabilities=CAPABILITIES,
+            generic_content=True,  # plain numbers: a more specific format wins
         )
     )

@@ -162,3 +162,20 @@ def test_module_examples() -> None:
     result = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0
     assert result.failed == 0
+
+
+def test_a_specific_sniffer_beats_the_generic_table(tmp_path: Path) -> None:
+    from geobrep.registry import FormatRegistry, FormatSpec
+
+    path = tmp_path / "survey.txt"
+    path.write_text("1 2 3\n4 5 6\n")
+    csv = registries().formats.get("csv")
+    assert csv.generic_content
+    specific = FormatSpec(
+        name="survey", extensions=(".srv",), reader=lambda p, o: None, sniff=lambda h: True
+    )
+    assert FormatRegistry([csv, specific]).choose_reader(path).name == "survey"
+    assert FormatRegistry([csv]).choose_reader(path).name == "csv"
+    twin = specific.model_copy(update={"name": "twin"})
+    with pytest.raises(geobrep.UnknownFormatError, match="several formats can read"):
+        FormatRegistry([csv, specific, twin]).choose_reader(path)
