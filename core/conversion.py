@@ -180,10 +180,14 @@ def _targets(
         return [output]
     if out_dir is None:
         raise OptionsError("give an output file, or out_dir=... with to=... for many files")
-    if not out_dir.is_dir():
-        raise FileAccessError("the output folder does not exist", out_dir)
     if to is None:
         raise OptionsError("converting into a folder needs the target format: to='vtu'")
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FileAccessError(
+            f"cannot create the output folder ({exc.strerror or exc})", out_dir
+        ) from exc
     from geobrep.plugins import registries
 
     formats = registries().formats

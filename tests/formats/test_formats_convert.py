@@ -11,7 +11,7 @@ from geobrep.cli.main import main
 from geobrep.conversion import ConversionSummary, convert, demo_stage, expand
 from geobrep.demo import DemoContext
 from geobrep.entities import Surface
-from geobrep.errors import OptionsError
+from geobrep.errors import FileAccessError, OptionsError
 from geobrep.io import read, write
 from geobrep.scene import Scene
 
@@ -101,6 +101,32 @@ def test_arguments_are_checked(tmp_path: Path) -> None:
         convert(["a.ply"], out_dir=tmp_path)
     with pytest.raises(OptionsError, match="jobs"):
         convert(["a.ply"], out_dir=tmp_path, to="vtu", jobs=0)
+
+
+def test_batch_on_a_dask_cluster_of_worker_processes(batch: Path, tmp_path: Path) -> None:
+    """Workers in separate processes: the per-file work and its reports travel by pickling."""
+    distributed = pytest.importorskip("distributed")
+    sources = [*sorted(batch.glob("tile_0*.ply"))[:20], batch / "tile_corrupt.ply"]
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        summary = convert(sources, out_dir=tmp_path / "new" / "folder", to="vtu", client=client)
+    assert [r.source.name for r in summary.failed] == ["tile_corrupt.ply"]
+    assert len(summary.converted) == 20
+    assert all(r.target is not None and r.target.is_file() for r in summary.converted)
+
+
+def test_output_folder_is_created_or_refused(tmp_path: Path) -> None:
+    source = write(_tile(1), tmp_path / "t.ply")
+    summary = convert(source, out_dir=tmp_path / "a" / "b", to="vtu")
+    assert summary.ok
+    assert (tmp_path / "a" / "b" / "t.vtu").is_file()
+    (tmp_path / "file").write_text("")
+    with pytest.raises(FileAccessError, match="cannot create the output folder"):
+        convert(source, out_dir=tmp_path / "file" / "sub", to="vtu")
 
 
 def test_missing_inputs_and_name_clashes_are_reported(tmp_path: Path) -> None:
