@@ -5,7 +5,7 @@ from __future__ import annotations
 from functools import cached_property
 from typing import Any, ClassVar, Self
 
-from pydantic import Field, JsonValue, ValidationError, model_validator
+from pydantic import Field, JsonValue, PrivateAttr, ValidationError, model_validator
 
 from geobrep.errors import EntityValidationError
 from geobrep.geometry.bbox import BoundingBox
@@ -60,12 +60,17 @@ class Entity(FrozenModel):
     #: What one cell is for this entity type ("faces", "segments", ...), for messages.
     cell_noun: ClassVar[str] = "cells"
 
+    #: True once the cross-field checks passed. pydantic runs "after" validators again when a
+    #: validated instance goes into another model (a Scene): immutable, it needs no second look.
+    _checked: bool = PrivateAttr(default=False)
+
     def __init__(self, **data: Any) -> None:
         try:
             super().__init__(**data)
         except ValidationError as exc:
             label = describe_entity(type(self).__name__, data.get("name"), data.get("id"))
             raise translate_validation_error(label, exc) from exc
+        self._checked = True
 
     @property
     def label(self) -> str:
@@ -92,6 +97,8 @@ class Entity(FrozenModel):
 
     @model_validator(mode="after")
     def _validate_entity(self) -> Self:
+        if getattr(self, "_checked", False):
+            return self
         self._check()
         for field, props, count, noun in (
             ("point_data", self.point_data, self.n_points, "points"),

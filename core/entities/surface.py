@@ -126,7 +126,8 @@ class Surface(VertexEntity):
     def _check(self) -> None:
         n = self.n_vertices
         faces = self.faces
-        if faces.size:
+        # One pass over the faces: as unsigned integers, negative indices are huge ones.
+        if faces.size and int(faces.view(f"u{faces.dtype.itemsize}").max()) >= n:
             lo, hi = int(faces.min()), int(faces.max())
             if lo < 0:
                 row = int(np.argmax((faces < 0).any(axis=1)))
