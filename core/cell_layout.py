@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 from geobrep.crs import CRS
 from geobrep.entities import Entity, PointSet, PolyLine, Surface, TetMesh
-from geobrep.errors import FormatError
+from geobrep.errors import EntityValidationError, FormatError
 from geobrep.properties import Property, PropertyMap
 from geobrep.scene import Group, Scene
 
@@ -135,17 +135,20 @@ def header_applies(header: dict[str, Any] | None, cell_data: dict[str, Any]) -> 
     return ENTITY_ARRAY in cell_data or len(header.get("entities", ())) <= 1
 
 
-def _entity_cells(entity: Entity) -> tuple[str, NDArray[np.int64], NDArray[np.int64]]:
-    """Cell type, local connectivity and part label per cell of a mesh entity."""
+def _entity_cells(entity: Entity) -> tuple[str, NDArray[np.int64], NDArray[np.int64] | None]:
+    """Cell type, local connectivity and part label per cell of a mesh entity (None: all 0).
+
+    The entity's own arrays are returned when they already are int64 (no copies).
+    """
     if isinstance(entity, Surface):
         kind = "triangle" if entity.faces.shape[1] == 3 else "quad"
         labels = entity.patch_labels
-        parts = np.zeros(entity.n_faces, np.int64) if labels is None else labels
-        return kind, entity.faces.astype(np.int64), parts.astype(np.int64)
+        parts = None if labels is None else labels.astype(np.int64, copy=False)
+        return kind, entity.faces.astype(np.int64, copy=False), parts
     if isinstance(entity, TetMesh):
         labels = entity.region_labels
-        parts = np.zeros(entity.n_cells, np.int64) if labels is None else labels
-        return "tetra", entity.cells.astype(np.int64), parts.astype(np.int64)
+        parts = None if labels is None else labels.astype(np.int64, copy=False)
+        return "tetra", entity.cells.astype(np.int64, copy=False), parts
     if isinstance(entity, PolyLine):
         segments = entity.segments.astype(np.int64)
         counts = np.diff(entity.part_offsets) - 1 + entity.closed.astype(np.int64)
@@ -154,7 +157,7 @@ def _entity_cells(entity: Entity) -> tuple[str, NDArray[np.int64], NDArray[np.in
         return "line", segments, parts
     if isinstance(entity, PointSet):
         count = entity.n_points
-        return "vertex", np.arange(count, dtype=np.int64)[:, None], np.zeros(count, np.int64)
+        return "vertex", np.arange(count, dtype=np.int64)[:, None], None
     raise TypeError(f"{entity.label} has no cell layout")
 
 
@@ -164,6 +167,8 @@ def _merge_arrays(
     """One array over ``total`` elements from ``(start, stop, values)`` pieces; gaps filled."""
     dtype = np.result_type(*[values.dtype for _, _, values in owners])
     shape = owners[0][2].shape[1:]
+    if len(owners) == 1 and owners[0][:2] == (0, total) and owners[0][2].dtype == dtype:
+        return owners[0][2]  # one entity holds all the elements: its array as it is
     if dtype.kind == "f":
         merged = np.full((total, *shape), np.nan, dtype=dtype)
     else:
@@ -191,13 +196,12 @@ def scene_to_layout(scene: Scene, reserved: frozenset[str] = frozenset()) -> Cel
     point_offsets = np.cumsum([0] + [int(e.n_points) for e in kept])
     cell_counts: list[int] = []
     blocks: list[tuple[str, NDArray[np.int64]]] = []
-    entity_column: list[NDArray[np.int64]] = []
-    part_column: list[NDArray[np.int64]] = []
+    part_column: list[NDArray[np.int64] | None] = []
     for index, entity in enumerate(kept):
         kind, conn, parts = _entity_cells(entity)
-        blocks.append((kind, conn + point_offsets[index]))
+        offset = int(point_offsets[index])
+        blocks.append((kind, conn + offset if offset else conn))
         cell_counts.append(int(conn.shape[0]))
-        entity_column.append(np.full(conn.shape[0], entity.id, dtype=np.int64))
         part_column.append(parts)
     cell_offsets = np.cumsum([0, *cell_counts])
     n_points = int(point_offsets[-1])
@@ -228,9 +232,18 @@ def scene_to_layout(scene: Scene, reserved: frozenset[str] = frozenset()) -> Cel
     point_data, point_records = arrays_for("point_data")
     cell_data, cell_records = arrays_for("cell_data")
     if len(kept) > 1:
-        cell_data[ENTITY_ARRAY] = _small_ints(_concat(entity_column))
+        cell_data[ENTITY_ARRAY] = _small_ints(
+            np.repeat(np.asarray([e.id for e in kept], dtype=np.int64), cell_counts)
+        )
     if any(_has_parts(e) for e in kept):
-        cell_data[PART_ARRAY] = _small_ints(_concat(part_column))
+        cell_data[PART_ARRAY] = _small_ints(
+            _concat(
+                [
+                    np.zeros(count, np.int64) if parts is None else parts
+                    for parts, count in zip(part_column, cell_counts, strict=True)
+                ]
+            )
+        )
     kept_ids = {e.id for e in kept}
     entities: list[dict[str, Any]] = []
     for index, entity in enumerate(kept):
@@ -263,8 +276,9 @@ def scene_to_layout(scene: Scene, reserved: frozenset[str] = frozenset()) -> Cel
         "groups": [_group_json(g, kept_ids) for g in scene.groups],
         "entities": entities,
     }
+    vertices = [cast(Any, e).vertices for e in kept]
     return CellLayout(
-        points=_concat_points([cast(Any, e).vertices for e in kept]),
+        points=vertices[0] if len(vertices) == 1 else _concat_points(vertices),
         blocks=blocks,
         point_data=point_data,
         cell_data=cell_data,
@@ -320,18 +334,20 @@ def layout_to_scene(layout: CellLayout, source: Any = None) -> Scene:
         raise FormatError(f"points must be (N, 3), got shape {points.shape}", source)
     if points.shape[1] == 2:
         points = np.column_stack([points, np.zeros(len(points))])
+    header = layout.header
+    if header is not None and header_applies(header, layout.cell_data):
+        try:
+            return _scene_from_header(layout, points, header)
+        except EntityValidationError as exc:  # each entity checks its cells' vertex indices
+            raise FormatError(str(exc), source) from exc
+        except (KeyError, IndexError, TypeError, ValueError) as exc:
+            raise FormatError(f"inconsistent geobrep header: {exc}", source) from exc
     for kind, conn in layout.blocks:
         if conn.size and (conn.min() < 0 or conn.max() >= len(points)):
             raise FormatError(
                 f"{kind} cells refer to point {int(conn.max())} but there are {len(points)} points",
                 source,
             )
-    header = layout.header
-    if header is not None and header_applies(header, layout.cell_data):
-        try:
-            return _scene_from_header(layout, points, header)
-        except (KeyError, IndexError, TypeError, ValueError) as exc:
-            raise FormatError(f"inconsistent geobrep header: {exc}", source) from exc
     return _scene_from_cells(layout, points)
 
 
@@ -396,8 +412,11 @@ def _scene_from_header(
         _kind, conn, mask = _cells_of(layout, int(record["id"]))
         if start:
             conn = conn - start  # the entity's own checks catch indices outside its points
+        has_parts = record.get("has_patches") or record.get("has_regions")
         parts = (
-            np.asarray(parts_all).astype(np.int64).ravel()[mask]
+            None
+            if not has_parts
+            else np.asarray(parts_all).astype(np.int64).ravel()[mask]
             if parts_all is not None
             else np.zeros(len(conn), np.int64)
         )
