@@ -72,7 +72,7 @@ def layout_from_mesh(mesh: Any, path: Path | None = None) -> CellLayout:
     for name, per_block in mesh.cell_data.items():
         arrays = [np.asarray(a) for a, k in zip(per_block, keep, strict=True) if k]
         if arrays:
-            cell_data[name] = np.concatenate(arrays)
+            cell_data[name] = arrays[0] if len(arrays) == 1 else np.concatenate(arrays)
     header = None
     raw = mesh.field_data.get(HEADER_ARRAY)
     if raw is not None:

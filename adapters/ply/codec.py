@@ -315,7 +315,7 @@ def _from_header(
                 template = next(p[name] for p in pieces if name in p)
                 fill = np.zeros((len(conn), *template.shape[1:]), dtype=template.dtype)
                 parts.append(fill)
-        cell_data[name] = np.concatenate(parts)
+        cell_data[name] = parts[0] if len(parts) == 1 else np.concatenate(parts)
     layout = CellLayout(
         points=points,
         blocks=blocks,

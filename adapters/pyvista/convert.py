@@ -102,6 +102,19 @@ def layout_to_dataset(layout: CellLayout) -> Any:
 def dataset_to_layout(dataset: Any) -> CellLayout:
     """The cells of any VTK dataset: polygons and strips triangulated, poly-lines split."""
     pv = import_pyvista("converting from pyvista")
+    uniform = _uniform_faces(dataset) if isinstance(dataset, pv.PolyData) else None
+    if uniform is not None:  # only triangles (or only quads): the arrays as VTK holds them
+        header = None
+        if HEADER_ARRAY in dataset.field_data:
+            header = decode_header(dataset.field_data[HEADER_ARRAY])
+        cell_data = {name: np.asarray(dataset.cell_data[name]) for name in dataset.cell_data}
+        return CellLayout(
+            points=np.asarray(dataset.points, dtype=np.float64),
+            blocks=[uniform],
+            point_data={name: np.asarray(dataset.point_data[name]) for name in dataset.point_data},
+            cell_data=cell_data,
+            header=header if header_applies(header, cell_data) else None,
+        )
     if isinstance(dataset, pv.PolyData) and (dataset.n_strips or _has_polygons(dataset)):
         dataset = dataset.triangulate(inplace=False)
     if isinstance(dataset, pv.PolyData):
@@ -199,6 +212,25 @@ def _polydata_cells(
     if not types:
         return np.zeros(0, np.int64), np.zeros(1, np.int64), np.zeros(0, np.int64)
     return np.concatenate(types), np.concatenate(offsets), np.concatenate(connectivity)
+
+
+def _uniform_faces(polydata: Any) -> tuple[str, NDArray[np.int64]] | None:
+    """``("triangle" | "quad", faces)`` of a PolyData holding only faces of that one size."""
+    if polydata.GetNumberOfVerts() or polydata.GetNumberOfLines() or polydata.GetNumberOfStrips():
+        return None
+    if not polydata.GetNumberOfPolys():
+        return None
+    from vtkmodules.util import numpy_support
+
+    vtk_to_numpy: Callable[[Any], NDArray[Any]] = numpy_support.vtk_to_numpy
+    polys = polydata.GetPolys()
+    offsets = vtk_to_numpy(polys.GetOffsetsArray())
+    n = offsets.shape[0] - 1
+    width = int(offsets[-1]) // n
+    if width not in (3, 4) or not np.array_equal(offsets, np.arange(0, width * n + 1, width)):
+        return None
+    faces = vtk_to_numpy(polys.GetConnectivityArray()).astype(np.int64, copy=False)
+    return ("triangle" if width == 3 else "quad"), faces.reshape(n, width)
 
 
 def _has_polygons(polydata: Any) -> bool:
