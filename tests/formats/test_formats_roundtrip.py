@@ -105,3 +105,25 @@ def test_surface_formats_refuse_a_scene_without_surfaces(scene: Scene, tmp_path:
         write(wells, tmp_path / "w.stl")
     assert not (tmp_path / "w.stl").exists()
     assert list(tmp_path.iterdir()) == []  # nothing half-written
+
+
+@pytest.mark.parametrize("extension", [".ply", ".vtp"])
+def test_face_index_beyond_the_points_of_a_geobrep_file_is_a_format_error(
+    extension: str, tmp_path: Path
+) -> None:
+    from geobrep.entities import Surface
+
+    surface = Surface(vertices=np.eye(3), faces=[[0, 1, 2]], name="one", cell_data={"z": [7]})
+    path = write(Scene(entities=[surface]), tmp_path / f"one{extension}")
+    if extension == ".ply":  # the binary face record ends with its 3 int32 indices and z
+        data = bytearray(path.read_bytes())
+        data[-8:-4] = np.int32(9).tobytes()
+        path.write_bytes(bytes(data))
+    else:
+        pv = pytest.importorskip("pyvista")
+        mesh = pv.read(path)
+        mesh.faces = np.array([3, 0, 1, 9])
+        mesh.save(path)
+    with pytest.raises(FormatError, match="refers to vertex 9") as caught:
+        read(path)
+    assert caught.value.path == path
