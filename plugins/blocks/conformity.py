@@ -4,7 +4,9 @@
   in shared vertices or edges. Pairs that share no vertex (after merging) yet intersect — within
   the merge tolerance — are surfaces crossing without an intersection line, or T-junctions
   (a vertex of one surface lying on a triangle of another). Candidates come from a grid broad
-  phase; the narrow phase tests the six edge–triangle combinations of each pair.
+  phase; the narrow phase first drops the pairs a plane keeps apart (:func:`separated`: one
+  triangle wholly beyond the other's plane or one of its sides), then tests the six
+  edge–triangle combinations of the others.
 * **Gaps**: a vertex on a free border (an edge used by one triangle) lying within
   ``gap_tolerance`` of another surface — not one holding it or its neighbours along the border —
   is a surface that stops just short of the one it should meet.
@@ -32,6 +34,7 @@ __all__ = [
     "NonConformity",
     "check_conformity",
     "point_triangle_distance",
+    "separated",
     "triangles_intersect",
 ]
 
@@ -251,10 +254,74 @@ def _edges_touching(one: FloatArray, other: FloatArray, tol: float) -> BoolArray
     return hits
 
 
+def _cross_rows(u: FloatArray, v: FloatArray) -> FloatArray:
+    """Cross products of vectors stored component-major: ``(..., 3, K)`` arrays (broadcasting)."""
+    ux, uy, uz = u[..., 0, :], u[..., 1, :], u[..., 2, :]
+    vx, vy, vz = v[..., 0, :], v[..., 1, :], v[..., 2, :]
+    return np.stack([uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx], axis=-2)
+
+
+def _apart(one: FloatArray, other: FloatArray, tol: float) -> BoolArray:
+    """Whether triangles ``one`` (component-major: (corner, xyz, K)), grown by ``tol`` to the
+    region the edge test calls inside, lie wholly more than ``tol`` beyond a plane of ``other``:
+    above or under its plane (Möller's plane-side test), or outside one of its sides (the plane
+    through the side perpendicular to the triangle)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # The grown triangle: scaled about the incentre by (r + tol) / r, r the inradius.
+        side = one[_NEXT] - one  # side j runs from corner j to j + 1
+        length = np.sqrt((side * side).sum(axis=1))  # (side, K)
+        perimeter = length.sum(axis=0)
+        normal = _cross_rows(side[0], -side[2])
+        area2 = np.sqrt((normal * normal).sum(axis=0))
+        centre = (length[[1, 2, 0], None, :] * one).sum(axis=0) / perimeter
+        grown = centre + (1.0 + tol * perimeter / area2) * (one - centre)
+        # The planes of the other triangle.
+        side = other[_NEXT] - other
+        normal = _cross_rows(side[0], -side[2])
+        unit = normal / np.sqrt((normal * normal).sum(axis=0))
+        inward = _cross_rows(unit, side) / np.sqrt((side * side).sum(axis=1))[:, None, :]
+        height = (grown * unit).sum(axis=1) - (other[0] * unit).sum(axis=0)  # (corner, K)
+        reach = (grown[:, None] * inward).sum(axis=2) - (other * inward).sum(axis=1)
+    above, under, outside = height > tol, height < -tol, reach < -tol  # outside: (corner, side, K)
+    beyond = outside[0] & outside[1] & outside[2]  # (side, K)
+    return np.asarray(
+        (above[0] & above[1] & above[2])
+        | (under[0] & under[1] & under[2])
+        | beyond[0]
+        | beyond[1]
+        | beyond[2]
+    )
+
+
+def separated(first: FloatArray, second: FloatArray, tol: float) -> BoolArray:
+    """Pairs of triangles that a plane separates by more than ``tol`` — so that
+    :func:`triangles_intersect` is false for them — found cheaply (Möller's plane-side test and
+    the in-plane side planes of each triangle, against the other grown by ``tol``).
+
+    Rejecting these never changes a decision: a triangle lying wholly more than ``tol`` above
+    the other's plane (or outside one of its sides), even when grown to the region the edge test
+    calls inside, can neither reach the other with an edge nor be reached by one of its edges.
+
+    >>> import numpy as np
+    >>> flat = np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0]]], dtype=float)
+    >>> separated(flat, flat + [0.0, 0.0, 1.0], 0.1).tolist(), separated(flat, flat, 0.1).tolist()
+    ([True], [False])
+    """
+    # A little more than tol, against rounding in the planes and the grown corners.
+    scale = max(float(np.abs(first).max(initial=0.0)), float(np.abs(second).max(initial=0.0)))
+    margin = tol * (1.0 + 1e-6) + 1e-12 * scale
+    one, other = first.transpose(1, 2, 0).copy(), second.transpose(1, 2, 0).copy()
+    apart = _apart(one, other, margin)
+    rest = np.flatnonzero(~apart)
+    apart[rest] = _apart(other[:, :, rest], one[:, :, rest], margin)
+    return apart
+
+
 def triangles_intersect(first: FloatArray, second: FloatArray, tol: float) -> BoolArray:
     """Whether triangles ``first[i]`` and ``second[i]`` ((K, 3, 3) corners) meet within ``tol``:
     an edge of one crosses or touches the other (closed triangles), or, lying in the other's
-    plane, comes within ``tol`` of it.
+    plane, comes within ``tol`` of it. Pairs a plane keeps apart (:func:`separated`) are
+    answered first; the edge tests run on the others.
 
     >>> import numpy as np
     >>> flat = np.array([[[0, 0, 0], [2, 0, 0], [0, 2, 0]]], dtype=float)
@@ -267,9 +334,9 @@ def triangles_intersect(first: FloatArray, second: FloatArray, tol: float) -> Bo
     hits = np.zeros(first.shape[0], dtype=np.bool_)
     for start in range(0, first.shape[0], _BATCH):
         one, other = first[start : start + _BATCH], second[start : start + _BATCH]
-        hits[start : start + _BATCH] = _edges_touching(one, other, tol) | _edges_touching(
-            other, one, tol
-        )
+        todo = np.flatnonzero(~separated(one, other, tol))
+        one, other = one[todo], other[todo]
+        hits[start + todo] = _edges_touching(one, other, tol) | _edges_touching(other, one, tol)
     return hits
 
 
@@ -289,9 +356,12 @@ def _crossings(soup: Soup, tol: float) -> list[NonConformity]:
     i, j = overlapping_pairs(corners, soup.triangle_surface, margin=tol)
     if i.size == 0:
         return []
-    ti, tj = soup.triangles[i], soup.triangles[j]
-    shared = (ti[:, :, None] == tj[:, None, :]).any(axis=(1, 2))
-    i, j = i[~shared], j[~shared]
+    ti, tj = soup.triangles[i].T, soup.triangles[j].T
+    apart = np.ones(i.shape[0], dtype=np.bool_)
+    for a in range(3):
+        for b in range(3):
+            apart &= ti[a] != tj[b]
+    i, j = i[apart], j[apart]
     hit = triangles_intersect(corners[i], corners[j], tol)
     i, j = i[hit], j[hit]
     if i.size == 0:

@@ -16,7 +16,13 @@ from geobrep.errors import TopologyError
 from geobrep.plugins.blocks.arcs import chain_arcs
 from geobrep.plugins.blocks.assembly import Assembly, assemble
 from geobrep.plugins.blocks.broad_phase import overlapping_pairs
-from geobrep.plugins.blocks.conformity import _segment_pairs_hit, triangles_intersect
+from geobrep.plugins.blocks.conformity import (
+    _segment_distance,
+    _segment_pairs_hit,
+    point_triangle_distance,
+    separated,
+    triangles_intersect,
+)
 from geobrep.plugins.blocks.measures import PatchMeasures, measure_patches
 from geobrep.plugins.blocks.patches import PatchSplit, split_patches
 from geobrep.plugins.blocks.radial_sort import sort_arcs
@@ -160,3 +166,82 @@ def test_all_edges_test_matches_the_edge_by_edge_test(tol: float) -> None:
     assert fast.any()
     assert not fast.all()
     np.testing.assert_array_equal(fast, slow)
+
+
+def triangle_distances(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Distance between triangles ``first[k]`` and ``second[k]``: 0 where they intersect, else
+    the least of the corner-to-triangle and edge-to-edge distances."""
+    crossing = triangles_intersect(first, second, 0.0)
+    best = np.full(first.shape[0], np.inf)
+    for one, other in ((first, second), (second, first)):
+        for c in range(3):
+            best = np.minimum(
+                best, point_triangle_distance(one[:, c], other[:, 0], other[:, 1], other[:, 2])
+            )
+    for e in range(3):
+        for f in range(3):
+            best = np.minimum(
+                best,
+                _segment_distance(
+                    first[:, e], first[:, (e + 1) % 3], second[:, f], second[:, (f + 1) % 3]
+                ),
+            )
+    return np.where(crossing, 0.0, best)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_broad_phase_keeps_large_triangles_near_what_they_meet(seed: int) -> None:
+    # Long fan triangles in the wall y = 0 (as a coarse model boundary) and small triangles of
+    # other surfaces around it, some touching it: the large ones are kept only in the cells
+    # they come near, yet every pair closer than the margin is found.
+    rng = np.random.default_rng(seed)
+    apex = np.array([0.0, 0.0, 10.0])
+    base = np.stack([np.linspace(-10.0, 10.0, 41), np.zeros(41), np.zeros(41)], axis=1)
+    fan = np.stack([np.repeat(apex[None], 40, axis=0), base[:-1], base[1:]], axis=1)
+    n = 500
+    centres = rng.uniform([-10.0, -1.0, 0.0], [10.0, 1.0, 10.0], size=(n, 1, 3))
+    centres[: n // 4, 0, 1] = rng.choice([-1.0, 1.0], n // 4) * 10.0 ** rng.uniform(-6, -2, n // 4)
+    small = centres + 0.4 * rng.normal(size=(n, 3, 3))
+    corners = np.concatenate([fan, small])
+    groups = np.concatenate([np.zeros(40, np.int64), rng.integers(1, 4, size=n)])
+    order = np.argsort(groups, kind="stable")
+    corners, groups = corners[order], groups[order]
+    margin = 1e-3
+    i, j = overlapping_pairs(corners, groups, margin=margin)
+    found = set(zip(i.tolist(), j.tolist(), strict=True))
+    assert len(found) == i.size
+    a, b = np.array(sorted(brute_force_pairs(corners, groups, margin))).T
+    close = triangle_distances(corners[a], corners[b]) <= margin
+    assert close[groups[a] == 0].sum() > 10  # the wall is met
+    assert set(zip(a[close].tolist(), b[close].tolist(), strict=True)) <= found
+    assert found <= brute_force_pairs(corners, groups, margin)
+
+
+@pytest.mark.parametrize("tol", [1e-9, 1e-4, 0.05])
+def test_plane_rejection_never_changes_a_decision(tol: float) -> None:
+    # Slivers with sharp corners, corners placed within a few tol of the other triangle's
+    # corner, and pairs in one plane: the cases where a plane-side test on the bare corners
+    # would disagree with the edge tests (the edge tests call "inside" a region that reaches
+    # past a sharp corner by more than tol). The rejection grows each triangle to that region.
+    rng = np.random.default_rng(11)
+    n = 20000
+    first = rng.normal(size=(n, 3, 3))
+    sliver = rng.uniform(size=n) < 0.3
+    first[sliver, 2] = (
+        first[sliver, 0]
+        + rng.uniform(0.0, 1e-2, size=(int(sliver.sum()), 1))
+        * (first[sliver, 1] - first[sliver, 0])
+        + 1e-3 * rng.normal(size=(int(sliver.sum()), 3))
+    )
+    second = rng.normal(size=(n, 3, 3))
+    near = rng.uniform(size=n) < 0.5
+    shift = first[near, 0] + 3.0 * tol * rng.normal(size=(int(near.sum()), 3)) - second[near, 0]
+    second[near] += shift[:, None, :]
+    flat = rng.uniform(size=n) < 0.2
+    first[flat, :, 2] = 0.0
+    second[flat, :, 2] = 2.0 * tol * rng.normal(size=(int(flat.sum()), 1))
+    apart = separated(first, second, tol)
+    slow = _segment_pairs_hit(first, second, tol)
+    assert 0.2 * n < apart.sum() < n - slow.sum()
+    assert not (apart & slow).any()
+    np.testing.assert_array_equal(triangles_intersect(first, second, tol), slow)
