@@ -39,6 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from geobrep.entities import Surface
 from geobrep.errors import TopologyError
 from geobrep.geometry import mesh
+from geobrep.geometry.bbox import column_extremes
 from geobrep.scene import Scene
 from geobrep.topology import Arc, Corner, Patch, Topology
 
@@ -136,7 +137,8 @@ def corners_and_arcs(
     used, compact = np.unique(triangles, return_inverse=True)
     points = vertices[used]
     if tolerance is None:
-        diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+        low, high = column_extremes(points)
+        diagonal = float(np.linalg.norm(high - low))
         tolerance = DEFAULT_RELATIVE_TOLERANCE * (diagonal if diagonal > 0 else 1.0)
     merged, inverse = mesh.merge_close_vertices(points, tolerance)
     tri = inverse[compact.reshape(-1, 3)]
@@ -210,7 +212,7 @@ def corners_and_arcs(
         if hints.shape[0]:
             from scipy.spatial import cKDTree
 
-            centre = 0.5 * (merged.min(axis=0) + merged.max(axis=0))
+            centre = 0.5 * np.add(*column_extremes(merged))
             distance, nearest = cKDTree(merged - centre).query(hints - centre)
             hit = nearest[distance <= max(tolerance, 0.0) * 1.0000001 + 0.0]
             is_corner[hit[degree[hit] > 0]] = True

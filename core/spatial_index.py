@@ -9,7 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from geobrep.errors import EntityValidationError
-from geobrep.geometry.bbox import BoundingBox, boxes_plane_side
+from geobrep.geometry.bbox import BoundingBox, boxes_plane_side, column_extremes
 from geobrep.geometry.plane import Plane
 
 __all__ = ["SpatialIndex"]
@@ -130,7 +130,7 @@ class SpatialIndex:
         """
         if len(self) == 0:
             return None
-        return BoundingBox(self._mins.min(axis=0), self._maxs.max(axis=0))
+        return BoundingBox(column_extremes(self._mins)[0], column_extremes(self._maxs)[1])
 
     def __len__(self) -> int:
         return int(self._ids.shape[0])

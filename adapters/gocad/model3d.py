@@ -21,6 +21,7 @@ from geobrep.adapters.gocad.objects import gocad_section
 from geobrep.adapters.gocad.parser import GocadObject
 from geobrep.arcs import corners_and_arcs
 from geobrep.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
+from geobrep.geometry.bbox import column_extremes
 from geobrep.scene import Group
 from geobrep.topology import Patch, Topology
 
@@ -87,7 +88,8 @@ def attach_model3d(
     points = [s.vertices for s in surfaces if s.n_vertices]
     if points:
         stacked = np.concatenate(points)
-        diagonal = float(np.linalg.norm(stacked.max(axis=0) - stacked.min(axis=0)))
+        low, high = column_extremes(stacked)
+        diagonal = float(np.linalg.norm(high - low))
     else:
         diagonal = 1.0
     key_tolerance = 1e-9 * max(diagonal, 1.0)
@@ -289,7 +291,8 @@ def border_topology(surfaces: list[Surface], options: Any) -> Topology:
         )
     ]
     points = np.concatenate([s.vertices for s in surfaces if s.n_vertices] or [np.zeros((1, 3))])
-    diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+    low, high = column_extremes(points)
+    diagonal = float(np.linalg.norm(high - low))
     corners, arcs, patch_arcs = corners_and_arcs(
         {int(s.id or 0): s for s in surfaces},
         patches,

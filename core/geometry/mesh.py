@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from geobrep.errors import DegenerateGeometryError, EntityValidationError
+from geobrep.geometry.bbox import column_extremes
 from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
 
 __all__ = [
@@ -288,7 +289,7 @@ def signed_volume(vertices: ArrayLike, faces: ArrayLike) -> float:
     verts, f = _mesh(vertices, faces, "signed_volume")
     if f.shape[0] == 0:
         return 0.0
-    columns = _columns(verts, 0.5 * (verts.min(axis=0) + verts.max(axis=0)))
+    columns = _columns(verts, 0.5 * np.add(*column_extremes(verts)))
     tris, _ = triangulate(f)
     a = _gather(columns, tris[:, 0])
     cross = _cross(_gather(columns, tris[:, 1]), _gather(columns, tris[:, 2]))
@@ -411,8 +412,9 @@ def _merge_candidates(local: FloatArray, tol: float) -> IntArray:
     margin = 2.0 * tol + 8.0 * np.finfo(np.float64).eps * reach
     near_face = ((offsets <= margin) | (offsets >= cell - margin)).any(axis=1)
     cubes = scaled.astype(np.int64)
-    cubes -= cubes.min(axis=0)
-    dims = cubes.max(axis=0) + 1
+    low, high = column_extremes(cubes)
+    cubes -= low
+    dims = high - low + 1
     keys = (cubes[:, 0] * dims[1] + cubes[:, 1]) * dims[2] + cubes[:, 2]
     sorted_keys, order = _stable_sort(keys)
     same = sorted_keys[1:] == sorted_keys[:-1]
@@ -459,7 +461,7 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
         _, first, labels = np.unique(verts + 0.0, axis=0, return_index=True, return_inverse=True)
         labels = labels.reshape(-1)
     else:
-        centre = 0.5 * (verts.min(axis=0) + verts.max(axis=0))
+        centre = 0.5 * np.add(*column_extremes(verts))
         from scipy.sparse import coo_matrix  # imported here: keeps `import geobrep` fast
         from scipy.sparse.csgraph import connected_components
         from scipy.spatial import cKDTree

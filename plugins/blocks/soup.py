@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 from geobrep.entities import Surface
 from geobrep.errors import DegenerateGeometryError
 from geobrep.geometry import mesh
+from geobrep.geometry.bbox import column_extremes
 
 __all__ = ["Soup", "build_soup"]
 
@@ -86,7 +87,7 @@ def build_soup(
     all_vertices = np.concatenate([s.vertices for s in surfaces]).astype(np.float64, copy=False)
     if all_vertices.shape[0] == 0:
         raise DegenerateGeometryError("block builder: the surfaces have no vertices")
-    lower, upper = all_vertices.min(axis=0), all_vertices.max(axis=0)
+    lower, upper = column_extremes(all_vertices)
     centre = 0.5 * (lower + upper)
     diagonal = float(np.linalg.norm(upper - lower))
     if tolerance is None:

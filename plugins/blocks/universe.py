@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.geometry.bbox import column_extremes
 from geobrep.plugins.blocks.csr import group_sums
 from geobrep.plugins.blocks.measures import PatchMeasures
 from geobrep.plugins.blocks.patches import PatchSplit
@@ -110,8 +111,8 @@ def find_universe(
     region_component[regions.negative] = component
     regions_per_component = np.bincount(region_component, minlength=n_components)
 
-    lower = soup.vertices.min(axis=0)
-    box_volume = float(np.prod(soup.vertices.max(axis=0) - lower))
+    lower, upper = column_extremes(soup.vertices)
+    box_volume = float(np.prod(upper - lower))
     empty = _EMPTY_VOLUME_RTOL * max(box_volume, np.finfo(np.float64).tiny)
     order = np.lexsort((volume, region_component))
     first = np.ones(order.shape[0], dtype=np.bool_)
@@ -171,8 +172,8 @@ def _host_block(
         if volume[region] <= 0.0:
             continue
         a, b, c = _region_triangles(soup, split, regions, region)
-        lower = np.minimum(np.minimum(a, b), c).min(axis=0)
-        upper = np.maximum(np.maximum(a, b), c).max(axis=0)
+        lower = column_extremes(np.minimum(np.minimum(a, b), c))[0]
+        upper = column_extremes(np.maximum(np.maximum(a, b), c))[1]
         if np.any(point < lower) or np.any(point > upper):
             continue
         if winding_number(point, a, b, c) > 0.5:

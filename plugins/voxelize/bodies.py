@@ -10,6 +10,7 @@ from numpy.typing import NDArray
 from geobrep.entities import Block, Entity, Surface
 from geobrep.errors import DegenerateGeometryError, OptionsError, TopologyError
 from geobrep.geometry import mesh
+from geobrep.geometry.bbox import column_extremes
 from geobrep.scene import Scene
 
 __all__ = ["Body", "OctreeCube", "collect_bodies", "octree_cube"]
@@ -27,11 +28,11 @@ class Body:
 
     @property
     def mins(self) -> NDArray[np.float64]:
-        return np.asarray(self.vertices.min(axis=0), dtype=np.float64)
+        return np.asarray(column_extremes(self.vertices)[0], dtype=np.float64)
 
     @property
     def maxs(self) -> NDArray[np.float64]:
-        return np.asarray(self.vertices.max(axis=0), dtype=np.float64)
+        return np.asarray(column_extremes(self.vertices)[1], dtype=np.float64)
 
 
 @dataclass(frozen=True)

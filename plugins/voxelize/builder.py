@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 from geobrep.entities import LinearOctree
 from geobrep.errors import OptionsError
 from geobrep.geometry import mesh
+from geobrep.geometry.bbox import column_extremes
 from geobrep.geometry.morton import morton_decode
 from geobrep.plugins.voxelize.bodies import Body, collect_bodies, octree_cube
 from geobrep.plugins.voxelize.classify import OctantClassifier, PriorityClassifier
@@ -157,7 +158,7 @@ def build_octree(scene: Scene, options: VoxelizeOptions) -> LinearOctree:
     sub_edge = 1 << sub_depth
     cell = cube.size / float(1 << depth)
     grid = [(body.vertices - cube.origin) / cell for body in bodies]
-    boxes = [(g.min(axis=0), g.max(axis=0)) for g in grid]
+    boxes = [column_extremes(g) for g in grid]
     reports = [BodyReport(body) for body in bodies]
 
     parts: list[Leaves] = []
