@@ -50,8 +50,6 @@ from geobrep.fitting import FitReport, FitResult, fit
 from geobrep.geometry import BoundingBox, Plane
 from geobrep.io import read, write
 from geobrep.map_products import map_products
-from geobrep.pipeline import Pipeline
-from geobrep.pipeline_run import PipelineSummary, run_pipeline
 from geobrep.properties import Property
 from geobrep.scene import Group, Scene
 from geobrep.topology import Arc, Corner, Patch, Topology
@@ -59,6 +57,8 @@ from geobrep.voxelization import VoxelizationWarning, voxelize
 
 if TYPE_CHECKING:
     from geobrep import datasets, plugins
+    from geobrep.pipeline import Pipeline
+    from geobrep.pipeline_run import PipelineSummary, run_pipeline
 
 __version__ = "0.1.0"
 
@@ -121,14 +121,24 @@ __all__ = [
 ]
 
 _LAZY_SUBMODULES = {"plugins", "datasets"}
+#: Public names whose modules are imported on first use (their pydantic models take a while).
+_LAZY_NAMES = {
+    "Pipeline": "geobrep.pipeline",
+    "PipelineSummary": "geobrep.pipeline_run",
+    "run_pipeline": "geobrep.pipeline_run",
+}
 
 
 def __getattr__(name: str) -> Any:
-    """Import ``geobrep.plugins`` and ``geobrep.datasets`` on first use (keeps import fast)."""
+    """Import ``geobrep.plugins``, ``geobrep.datasets`` and the pipeline API on first use."""
     if name in _LAZY_SUBMODULES:
         return importlib.import_module(f"geobrep.{name}")
+    if name in _LAZY_NAMES:
+        value = getattr(importlib.import_module(_LAZY_NAMES[name]), name)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'geobrep' has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | _LAZY_SUBMODULES)
+    return sorted(set(globals()) | _LAZY_SUBMODULES | set(_LAZY_NAMES))
