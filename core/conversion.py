@@ -94,15 +94,19 @@ class ConversionSummary(BaseModel):
         for r in self.reports:
             notes = r.error if r.error else ("; ".join(r.lost) or "nothing lost")
             rows.append((r.status, str(r.source), str(r.target or "-"), notes or ""))
-        widths = [max(len(row[i]) for row in rows) for i in range(3)]
-        lines = [
-            "  ".join(cell.ljust(width) for cell, width in zip(row[:3], widths, strict=True))
-            + "  "
-            + row[3]
-            for row in rows
-        ]
-        lines.append(f"{len(self.converted)} converted, {len(self.failed)} failed")
-        return "\n".join(lines)
+        return report_table(rows, f"{len(self.converted)} converted, {len(self.failed)} failed")
+
+
+def report_table(rows: Sequence[tuple[str, str, str, str]], totals: str) -> str:
+    """Rows of four cells as aligned text (the last cell free-form), then a totals line."""
+    widths = [max(len(row[i]) for row in rows) for i in range(3)]
+    lines = [
+        "  ".join(cell.ljust(width) for cell, width in zip(row[:3], widths, strict=True))
+        + "  "
+        + row[3]
+        for row in rows
+    ]
+    return "\n".join([*lines, totals])
 
 
 def expand(inputs: PathArg | Iterable[PathArg]) -> list[Path]:

@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any, Literal
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.capabilities import capability_losses
-from geobrep.conversion import expand, run_each
+from geobrep.conversion import expand, report_table, run_each
 from geobrep.entities import Entity, NurbsSurface, PointSet, PolyLine
 from geobrep.errors import (
     EntityNotFoundError,
@@ -137,15 +137,7 @@ class PipelineSummary(BaseModel):
             outputs = ", ".join(p.name for p in r.outputs) or "-"
             notes = r.error or "; ".join(n for s in r.steps for n in s.notes) or ""
             rows.append((r.status, str(r.source), outputs, notes))
-        widths = [max(len(row[i]) for row in rows) for i in range(3)]
-        lines = [
-            "  ".join(cell.ljust(width) for cell, width in zip(row[:3], widths, strict=True))
-            + "  "
-            + row[3]
-            for row in rows
-        ]
-        lines.append(f"{len(self.done)} done, {len(self.failed)} failed")
-        return "\n".join(lines)
+        return report_table(rows, f"{len(self.done)} done, {len(self.failed)} failed")
 
 
 # ------------------------------------------------------------------------------- planning
