@@ -8,6 +8,7 @@ parse (:func:`parse_run`) and walks only the few remaining lines in Python.
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -247,10 +248,8 @@ def parse_run(source: Source, run: Run, integer: bool) -> NDArray[Any]:
     if integer and not only_integers:
         raise BulkParseError  # "1.0", "1e0": the line parser says why they are no ids
     starts = source.starts[run.first - 1 : run.first - 1 + run.count] - run.start
-    try:
+    with contextlib.suppress(BulkParseError):  # single blanks only: else renormalise, below
         return _parse_block(data, run.start, run.end, starts, len(keyword), only_integers)
-    except BulkParseError:
-        pass
     raw = _renormalised(data[run.start : run.end], keyword)
     breaks = np.flatnonzero(np.frombuffer(raw, dtype=np.uint8) == 10)
     if breaks.shape[0] != run.count - 1:
