@@ -59,13 +59,14 @@ lint: $(STAMPS)/test
 
 # mypy cannot follow setuptools' editable finder for the core/ -> geobrep mapping, so it checks a
 # tree of symbolic links laid out as the installed package.
+TYPECHECK_DIR ?= build/typecheck
 typecheck: $(STAMPS)/test
-	@rm -rf build/typecheck && mkdir -p build/typecheck/geobrep
-	@for entry in core/*; do ln -s "$(CURDIR)/$$entry" build/typecheck/geobrep/; done
-	@ln -s "$(CURDIR)/plugins" build/typecheck/geobrep/plugins
-	@ln -s "$(CURDIR)/adapters" build/typecheck/geobrep/adapters
-	@ln -s "$(CURDIR)/schemas" build/typecheck/geobrep/schemas
-	cd build/typecheck && MYPYPATH=. $(CURDIR)/$(VENV)/bin/mypy --config-file $(CURDIR)/pyproject.toml -p geobrep
+	@rm -rf $(TYPECHECK_DIR) && mkdir -p $(TYPECHECK_DIR)/geobrep
+	@for entry in core/*; do ln -s "$(CURDIR)/$$entry" $(TYPECHECK_DIR)/geobrep/; done
+	@ln -s "$(CURDIR)/plugins" $(TYPECHECK_DIR)/geobrep/plugins
+	@ln -s "$(CURDIR)/adapters" $(TYPECHECK_DIR)/geobrep/adapters
+	@ln -s "$(CURDIR)/schemas" $(TYPECHECK_DIR)/geobrep/schemas
+	cd $(TYPECHECK_DIR) && MYPYPATH=. $(CURDIR)/$(VENV)/bin/mypy --config-file $(CURDIR)/pyproject.toml -p geobrep
 
 pytest: $(STAMPS)/test sysdeps
 	$(PY) -m pytest
