@@ -77,13 +77,18 @@ def _check_readable(path: Path) -> None:
         raise FileAccessError(f"cannot be read ({exc.strerror or exc})", path) from exc
 
 
-def read(path: PathArg, format: str | None = None, **options: Any) -> Scene:
+def read(
+    path: PathArg, format: str | None = None, *, repair: bool = True, **options: Any
+) -> Scene:
     """Read a file into a :class:`Scene`, choosing the format by extension and content.
 
     ``format`` names a registered format explicitly; other keywords are that format's options
-    (validated by its options model). Errors: :class:`FileAccessError` for a missing or
-    unreadable file, :class:`UnknownFormatError` when no format matches, :class:`FormatError`
-    (with path and line) when the content is wrong.
+    (validated by its options model). ``repair`` (default ``True``) lets a reader mend what a
+    file gets wrong, with a warning for each repair (GOCAD: triangles flipped against their
+    TFACE's key triangle, REGION sides contradicting the geometry); ``repair=False`` keeps the
+    model exactly as the file holds it, defects included, for inspection. Errors:
+    :class:`FileAccessError` for a missing or unreadable file, :class:`UnknownFormatError` when
+    no format matches, :class:`FormatError` (with path and line) when the content is wrong.
     """
     from geobrep.plugins import registries
 
@@ -92,6 +97,8 @@ def read(path: PathArg, format: str | None = None, **options: Any) -> Scene:
     spec = registries().formats.choose_reader(source, format)
     if not spec.can_read or spec.reader is None:
         raise UnknownFormatError(f"format {spec.name!r} cannot read files", source)
+    if "repair" in spec.options.model_fields:
+        options = {"repair": repair, **options}
     validated = spec.validate_options(options)
     try:
         result = spec.reader(source, validated)

@@ -357,7 +357,8 @@ Applied = tuple[Scene, list[str]]
 
 
 def _read(step: ReadStep, scene: Scene, work: _Work) -> Applied:
-    return read(work.source, format=step.format, **step.options), []
+    options: dict[str, Any] = dict(step.options)  # may hold `repair`, checked by read
+    return read(work.source, format=step.format, **options), []
 
 
 def _reproject(step: ReprojectStep, scene: Scene, work: _Work) -> Applied:

@@ -22,6 +22,7 @@ from geobrep.adapters.gocad.parser import GocadObject
 from geobrep.arcs import corners_and_arcs
 from geobrep.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
 from geobrep.geometry.bbox import column_extremes
+from geobrep.model_orientation import orient_patches
 from geobrep.scene import Group
 from geobrep.topology import Patch, Topology
 
@@ -75,8 +76,12 @@ def attach_model3d(
     z_sign: float,
     options: Any,
     builder: Any,
-) -> tuple[Topology, list[Entity], list[Group], dict[str, Any]]:
-    """Topology, blocks, groups and scene metadata of a Model3d header."""
+) -> tuple[Topology, list[Entity], list[Group], dict[str, Any], list[Surface]]:
+    """Topology, blocks, groups, scene metadata and the member surfaces of a Model3d header.
+
+    With ``options.repair`` (the default) each TFACE's triangles are turned to agree with its
+    key triangle, so the surfaces returned may differ from those given.
+    """
     by_name: dict[str, Surface] = {}
     listed: set[str] = set()  # names given by name_in_model_list
     for surface in surfaces:
@@ -96,6 +101,7 @@ def attach_model3d(
     patches: list[Patch] = []
     flipped: dict[int, bool] = {}
     seen_parts: dict[str, int] = {}
+    key_faces: dict[int, dict[int, int | None]] = {}  # surface id -> patch label -> key face
     declared = set(model.model.get("tsurfs", []))
     for entry in model.model.get("tfaces", []):
         if entry["tsurf"] not in declared:
@@ -135,6 +141,7 @@ def attach_model3d(
                 entry["line"],
             )
         flipped[entry["id"]] = reverse
+        key_faces.setdefault(int(surface.id or 0), {})[label] = face
         gocad: dict[str, Any] = {"geological_type": entry["type"], "key_triangle": face}
         if reverse:
             gocad["key_reversed"] = True
@@ -147,6 +154,8 @@ def attach_model3d(
                 metadata={"gocad": gocad},
             )
         )
+    if getattr(options, "repair", True):
+        surfaces = _orient_by_key_triangles(surfaces, key_faces, patches, builder)
     patch_ids = {p.id for p in patches}
     blocks: list[Entity] = []
     region_block: dict[int, int] = {}
@@ -233,7 +242,33 @@ def attach_model3d(
     }
     if model.extra_lines:
         metadata["gocad"]["model3d"]["extra_lines"] = model.extra_lines
-    return topology, blocks, groups, metadata
+    return topology, blocks, groups, metadata, surfaces
+
+
+def _orient_by_key_triangles(
+    surfaces: list[Surface],
+    key_faces: dict[int, dict[int, int | None]],
+    patches: list[Patch],
+    builder: Any,
+) -> list[Surface]:
+    """Each TFACE's triangles turned to agree with its key triangle (one warning per surface)."""
+    tface_of = {(p.surface, p.label): p.id for p in patches}
+    out: list[Surface] = []
+    for surface in surfaces:
+        sid = int(surface.id or 0)
+        oriented, flips = orient_patches(surface, key_faces.get(sid, {}))
+        if flips:
+            total = sum(flips.values())
+            where = ", ".join(
+                f"TFACE {tface_of.get((sid, label), label + 1)}: {count}"
+                for label, count in sorted(flips.items())
+            )
+            builder.warn(
+                f"surface {surface.name!r}: {total} triangle(s) flipped to agree with the key "
+                f"triangle of their TFACE ({where}); read with repair=False to keep them as written"
+            )
+        out.append(oriented)
+    return out
 
 
 def _groups(

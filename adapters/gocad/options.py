@@ -18,6 +18,10 @@ class GocadOptions(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True)
 
+    repair: bool = True
+    """Reading: mend what a file gets wrong and say so in a warning (a TFACE's triangles turned
+    to agree with its key triangle, REGION sides that contradict the geometry reversed).
+    ``False`` keeps the model exactly as written, defects included (for inspection)."""
     vertex_ids: bool = False
     """Reading: add the file's vertex ids as the point property ``gocad_vertex_id``."""
     merge_tolerance: float | None = Field(default=None, ge=0)

@@ -27,6 +27,7 @@ from geobrep.adapters.gocad.parser import GROUP_TYPES, GocadObject, GocadWarning
 from geobrep.crs import CRS
 from geobrep.entities import Entity, PointSet, PolyLine, Surface, TetMesh
 from geobrep.errors import EntityValidationError, FormatError, TopologyError
+from geobrep.model_orientation import orient_blocks
 from geobrep.properties import Property
 from geobrep.scene import Group, Scene
 
@@ -153,15 +154,17 @@ class _Builder:
             name = model.name
             self._kinds_from_model(model)
             surfaces = [e for e in self.entities if isinstance(e, Surface)]
-            topology, blocks, model_groups, metadata = attach_model3d(
+            topology, blocks, model_groups, metadata, surfaces = attach_model3d(
                 model, surfaces, self.next_id(), self._z_sign(model), self.options, self
             )
+            by_id = {int(s.id or 0): s for s in surfaces}
+            self.entities = [by_id.get(int(e.id or 0), e) for e in self.entities]
         elif any(gocad_section(e.metadata).get("borders") for e in surfaces):
             from geobrep.adapters.gocad.model3d import border_topology
 
             topology = border_topology(surfaces, self.options)
         try:
-            return Scene(
+            scene = Scene(
                 entities=[*self.entities, *blocks],
                 groups=[*groups, *model_groups],
                 crs=crs,
@@ -171,6 +174,21 @@ class _Builder:
             )
         except (EntityValidationError, TopologyError) as exc:
             raise self.error(f"the file's objects do not form a valid scene: {exc}", None) from exc
+        if blocks and self.options.repair:
+            scene = self._orient_blocks(scene)
+        return scene
+
+    def _orient_blocks(self, scene: Scene) -> Scene:
+        """REGION sides reversed where the geometry contradicts them (one warning each)."""
+        try:
+            scene, notes = orient_blocks(scene)
+        except TopologyError as exc:
+            raise self.error(
+                f"{exc} (read with repair=False to load the model as written)", None
+            ) from exc
+        for note in notes:
+            self.warn(note)
+        return scene
 
     def _kinds_from_model(self, model: GocadObject) -> None:
         """Surfaces without a GEOLOGICAL_TYPE take the type of their header TFACEs."""
