@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.crs import CRS
+from geobrep.crs import CRS, CRSError, as_crs
 from geobrep.entities import (
     Annotation,
     Entity,
@@ -39,7 +39,7 @@ from geobrep.entities import (
     NurbsSurface,
     VertexEntity,
 )
-from geobrep.errors import GeobrepError, MissingDependencyError
+from geobrep.errors import MissingDependencyError
 from geobrep.scene import Scene
 
 if TYPE_CHECKING:
@@ -86,10 +86,6 @@ _SHORT_UNITS = {
 }
 
 
-class CRSError(GeobrepError, ValueError):
-    """A CRS is missing, cannot be parsed, or two CRSs cannot be transformed between."""
-
-
 def _pyproj() -> Any:
     try:
         import pyproj
@@ -98,18 +94,20 @@ def _pyproj() -> Any:
     return pyproj
 
 
-def _from_text(text: str | int, what: str) -> pyproj.CRS:
+def _from_text(text: Any, what: str) -> pyproj.CRS:
     lib = _pyproj()
     try:
         parsed: pyproj.CRS = lib.CRS.from_user_input(text)
-    except lib.exceptions.CRSError as exc:
-        first = str(exc).splitlines()[0]
+    except (lib.exceptions.CRSError, TypeError, ValueError) as exc:
+        first = (str(exc).splitlines() or [type(exc).__name__])[0]
         raise CRSError(f"{what} {str(text)[:80]!r} is not a valid CRS: {first}") from exc
     return parsed
 
 
 def parse_crs(value: CRS | str | int | Any) -> pyproj.CRS:
-    """A validated ``pyproj.CRS`` from a geobrep CRS, an EPSG code, WKT or a PROJ string.
+    """A validated ``pyproj.CRS`` from a geobrep CRS or anything ``pyproj.CRS.from_user_input``
+    accepts: an EPSG code, ``"EPSG:xxxx"``, WKT, a PROJ string, an ``(authority, code)`` pair,
+    a PROJJSON dict, an object with ``to_wkt()``.
 
     A 2D geobrep CRS whose ``vertical_datum`` names a vertical CRS (``"EPSG:5703"``) becomes a
     compound CRS. Raises :class:`CRSError` when nothing identifies the CRS.
@@ -129,8 +127,18 @@ def parse_crs(value: CRS | str | int | Any) -> pyproj.CRS:
         if not value.strip():
             raise CRSError("an empty string is not a CRS")
         return _from_text(value, "CRS")
+    if isinstance(value, dict) and set(value) <= set(CRS.model_fields):
+        value = as_crs(value)  # the fields of a geobrep CRS
     if not isinstance(value, CRS):
-        raise CRSError(f"expected a CRS, an EPSG code or a string, got {type(value).__name__}")
+        to_wkt = getattr(value, "to_wkt", None)
+        if not isinstance(value, tuple | list | dict) and callable(to_wkt):
+            return _from_text(to_wkt(), "CRS")
+        if isinstance(value, tuple | list | dict):
+            return _from_text(value, "CRS")
+        raise CRSError(
+            f"expected a CRS, an EPSG code, WKT, a PROJ string or an (authority, code) pair, "
+            f"got {type(value).__name__} {str(value)[:60]!r}"
+        )
     if value.epsg is not None:
         base = _from_text(f"EPSG:{value.epsg}", "EPSG code")
     elif value.wkt:
@@ -307,8 +315,20 @@ def transform_points(
     return _PointTransform(_as_crs(source), _as_crs(target))(points, "points")
 
 
-def _as_crs(value: CRS | str | int | Any) -> CRS:
-    return value if isinstance(value, CRS) else crs_from_user_input(value)
+def _as_crs(value: CRS | str | int | Any, what: str = "CRS") -> CRS:
+    """A geobrep CRS with what pyproj knows of it (name, axes), as the target of a transform."""
+    if isinstance(value, CRS):
+        return value
+    if value is None:
+        raise CRSError(f"{what}: None is not a CRS")
+    if isinstance(value, dict) and set(value) <= set(CRS.model_fields):
+        fields = as_crs(value, what)
+        assert fields is not None
+        return fields
+    try:
+        return crs_from_user_input(value)
+    except CRSError as exc:
+        raise CRSError(f"{what}: {exc}") from exc
 
 
 def _handedness(transform: _PointTransform, scene: Scene) -> float:
@@ -385,7 +405,7 @@ def to_crs(
         else Scene(entities=[obj] if isinstance(obj, Entity) else list(obj))
     )
     if source is not None:
-        source_crs = _as_crs(source)
+        source_crs = _as_crs(source, "source CRS")
     elif scene.crs is not None:
         source_crs = scene.crs
     else:
@@ -396,7 +416,7 @@ def to_crs(
         parse_crs(source_crs)
     except CRSError as exc:
         raise CRSError(f"source CRS: {exc}") from exc
-    target_crs = _as_crs(target)
+    target_crs = _as_crs(target, "target CRS")
     transform = _PointTransform(source_crs, target_crs)
     if _handedness(transform, scene) < 0:
         raise CRSError(
@@ -429,12 +449,12 @@ def _crs_text(crs: CRS | None) -> str | None:
         return None
 
 
-def to_geodataframe(entities: Scene | Entity | Iterable[Entity], crs: CRS | None = None) -> Any:
+def to_geodataframe(entities: Scene | Entity | Iterable[Entity], crs: Any = None) -> Any:
     """A ``geopandas.GeoDataFrame``: one row per point, line part, polygon or annotation.
 
     Columns are those of the GIS writers (``entity_id``, ``entity``, ``entity_type``, ``kind``,
     ``block_id``, ``unit_name``, ``horizon_name``, properties); ``layer`` says which layer a row
-    would go to. The CRS is the scene's (or ``crs``).
+    would go to. The CRS is the scene's (or ``crs``: a CRS or anything pyproj accepts).
 
     >>> import geobrep
     >>> pts = geobrep.PointSet(vertices=[[1.0, 2.0, 3.0]], point_data={"a": [7.0]}, name="p")
@@ -473,7 +493,7 @@ def to_geodataframe(entities: Scene | Entity | Iterable[Entity], crs: CRS | None
             else:
                 columns[name] = values
         frames.append(geopandas.GeoDataFrame(columns, geometry=list(table.geometry)))
-    crs_value = _crs_text(crs or (scene.crs if scene else None))
+    crs_value = _crs_text(as_crs(crs) if crs is not None else (scene.crs if scene else None))
     if not frames:
         return geopandas.GeoDataFrame({"layer": []}, geometry=[], crs=crs_value)
     frame = pandas.concat(frames, ignore_index=True)

@@ -121,15 +121,15 @@ class ReadStep(StepOptions):
 
 
 class ReprojectStep(StepOptions):
-    """Transform every entity into the CRS ``to`` (EPSG:xxxx, WKT, PROJ); ``from`` overrides
-    (or supplies) the CRS of the input."""
+    """Transform every entity into the CRS ``to`` (EPSG:xxxx or an EPSG code, WKT, PROJ);
+    ``from`` overrides (or supplies) the CRS of the input."""
 
     model_config = ConfigDict(populate_by_name=True)
 
     kind: ClassVar[str] = "reproject"
 
-    to: str
-    source: str | None = Field(default=None, alias="from")
+    to: str | int
+    source: str | int | None = Field(default=None, alias="from")
 
     def check(self, registries: Registries) -> None:
         from geobrep.crs_ops import crs_from_user_input

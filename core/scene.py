@@ -5,13 +5,13 @@ from __future__ import annotations
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
 from functools import cached_property
-from typing import Any, Self, TypeVar
+from typing import Annotated, Any, Self, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field, JsonValue, ValidationError, model_validator
+from pydantic import BeforeValidator, Field, JsonValue, ValidationError, model_validator
 
-from geobrep.crs import CRS
+from geobrep.crs import CRS, as_crs
 from geobrep.entities import (
     Annotation,
     AnyEntity,
@@ -86,7 +86,9 @@ class Scene(FrozenModel):
     """A structural model: entities, groups, CRS and topology.
 
     Entities get ids in order when they have none. A scene is immutable; operations return new
-    scenes (:meth:`with_entities`, :meth:`replace`).
+    scenes (:meth:`with_entities`, :meth:`replace`). ``crs`` takes a :class:`~geobrep.crs.CRS` or
+    what pyproj accepts (``"EPSG:32633"``, ``32633``, WKT, a ``pyproj.CRS``; see
+    :func:`geobrep.crs.as_crs`).
 
     >>> from geobrep import PointSet, Scene
     >>> scene = Scene(entities=[PointSet(vertices=[[0, 0, 0]], name="wells")])
@@ -96,7 +98,7 @@ class Scene(FrozenModel):
 
     entities: tuple[AnyEntity, ...] = ()
     groups: tuple[Group, ...] = ()
-    crs: CRS | None = None
+    crs: Annotated[CRS | None, BeforeValidator(as_crs)] = None
     topology: Topology = Field(default_factory=Topology)
     name: str = ""
     metadata: dict[str, JsonValue] = Field(default_factory=dict)

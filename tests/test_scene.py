@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from itertools import combinations
 from typing import Any
 
@@ -613,3 +614,34 @@ class TestLayerCake:
     def test_bad_arguments(self, kwargs: dict[str, Any], message: str) -> None:
         with pytest.raises(ValueError, match=message):
             geobrep.datasets.faulted_layer_cake(**kwargs)
+
+
+class TestCrsInput:
+    """``Scene(crs=...)`` takes EPSG codes as pyproj does, without importing pyproj."""
+
+    @pytest.mark.parametrize("value", ["EPSG:32631", "epsg:32631", 32631, "32631", ("EPSG", 32631)])
+    def test_epsg_codes(self, value: Any) -> None:
+        scene = Scene(entities=[wells()], crs=value)
+        assert scene.crs == CRS(epsg=32631)
+        assert scene.replace(crs=value).crs == CRS(epsg=32631)
+        assert scene.model_copy(update={"crs": value}).crs == CRS(epsg=32631)
+
+    def test_fields_and_none(self) -> None:
+        assert Scene(crs={"epsg": 4326, "z_positive": "down"}).crs == CRS(
+            epsg=4326, z_positive="down"
+        )
+        assert Scene(crs=CRS(epsg=4326)).replace(crs=None).crs is None
+
+    @pytest.mark.parametrize(
+        ("value", "message"),
+        [
+            (0, "CRS 0 is not a valid CRS: an EPSG code is a positive integer"),
+            ("EPSG:0", "CRS 'EPSG:0' is not a valid CRS"),
+            (True, "CRS True is not a CRS"),
+            (1.5, "CRS '1.5' is not a CRS"),
+            ({"epsg": -1}, "CRS {'epsg': -1}: epsg: Input should be greater than 0"),
+        ],
+    )
+    def test_bad_values_are_named(self, value: Any, message: str) -> None:
+        with pytest.raises(geobrep.GeobrepError, match=re.escape(message)):
+            Scene(crs=value)
