@@ -117,18 +117,22 @@ def build_blocks(scene: Scene, options: BlockBuilderOptions) -> Scene:
         else options.relative_gap_tolerance * soup.diagonal
     )
     removed: list[DanglingPatch] = []
+    open_border = ""  # the first free borders found, named if nothing closed is left
     passes = 0
     while True:
         passes += 1
         if soup.n_triangles == 0:
+            where = f": the model is open, {open_border}" if open_border else ""
             raise TopologyError(
                 "no closed block: every patch was dangling "
-                f"({len(removed)} removed; the surfaces enclose no volume)"
+                f"({len(removed)} removed; the surfaces enclose no volume){where}"
             )
         with watch.stage("patches"):
             split = split_patches(soup)
         with watch.stage("arcs"):
             chains = chain_arcs(split, soup.vertices.shape[0])
+        if passes == 1 and free_border_arcs(split, chains).size:
+            open_border = str(_free_border_error(soup, split, chains))
         if passes == 1 and options.check_conformity:
             with watch.stage("conformity"):
                 check_conformity(soup, split, gap_tolerance)
@@ -165,7 +169,8 @@ def build_blocks(scene: Scene, options: BlockBuilderOptions) -> Scene:
             continue
         break
     if bodies.universe < 0 or bodies.n_bodies < 2:
-        raise TopologyError("no closed block: the surfaces enclose no volume")
+        where = f": the model is open, {open_border}" if open_border else ""
+        raise TopologyError(f"no closed block: the surfaces enclose no volume{where}")
     with watch.stage("assembly"):
         assembly = assemble(scene, soup, split, chains, arcs, bodies, measures)
     built = assembly.scene
