@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import geobrep
-from geobrep import Plane, Scene, Surface, TopologyError
+from geobrep import Plane, Scene, TopologyError
 
 DATA = Path(__file__).resolve().parent / "data" / "gocad"
 MODELS = sorted(p.name for p in DATA.glob("*.ml"))
