@@ -2,7 +2,9 @@
 
 Points come from a CSV file (``x,y,z`` columns, header optional; further numeric columns become
 point properties) or from any registered format holding a PointSet. The surface is written to
-``OUT`` in the format of its extension (as a triangle mesh when that format cannot hold NURBS)::
+``OUT`` in the format of its extension. A format that cannot hold NURBS gets a triangle mesh
+refined until its σ and max |d| are within 2 % of the surface's (up to ``--max-triangles``); the
+report then gives the accuracy of both, and ``--check`` judges the mesh, the object written::
 
     geobrep fit survey.csv horizon.geobrep --method hybrid --epsilon 0.5
     geobrep fit survey.csv grid.geobrep --method kriging --option variogram_model=gaussian
@@ -15,8 +17,9 @@ import json
 from pathlib import Path
 from typing import Any
 
-from geobrep.entities import Entity, NurbsSurface, PointSet, PolyLine
+from geobrep.entities import Entity, PointSet, PolyLine
 from geobrep.errors import FileAccessError, FormatError, OptionsError
+from geobrep.fitting import MAX_TRIANGLES
 
 __all__ = ["add_parser", "run"]
 
@@ -49,7 +52,15 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument(
         "--check",
         action="store_true",
-        help=f"exit with status {EXIT_NOT_MET} when the report does not meet ε",
+        help=f"exit with status {EXIT_NOT_MET} when what was written does not meet ε",
+    )
+    parser.add_argument(
+        "--max-triangles",
+        type=int,
+        default=MAX_TRIANGLES,
+        metavar="N",
+        help="bound on the mesh written when OUT's format cannot hold NURBS "
+        f"(default {MAX_TRIANGLES})",
     )
     parser.set_defaults(run=run)
 
@@ -89,21 +100,17 @@ def _options(pairs: list[str]) -> dict[str, Any]:
 
 def run(args: argparse.Namespace) -> int:
     from geobrep.fitting import fit
-    from geobrep.io import atomic_write, write
-    from geobrep.plugins import registries
+    from geobrep.io import atomic_write
 
     points = _load_points(Path(args.points), args.format, args.entity)
     options = _options(args.option)
     if args.epsilon is not None:
         options["epsilon"] = args.epsilon
+    if args.max_triangles < 2:
+        raise OptionsError(f"--max-triangles must be at least 2, got {args.max_triangles}")
     result = fit(points, method=args.method, **options)
     out = Path(args.out)
-    surface: Entity = result.surface
-    writer = registries().formats.choose_writer(out)
-    types = writer.capabilities.entity_types
-    if isinstance(surface, NurbsSurface) and types and "NurbsSurface" not in types:
-        surface = surface.tessellate(tolerance=1e-3 * float(surface.bounds.diagonal))  # type: ignore[union-attr]
-    write(surface, out)
+    result = result.write(out, max_triangles=args.max_triangles)
     report = result.report
     if report is not None and args.report:
         with atomic_write(args.report) as tmp:
@@ -115,6 +122,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"{args.method} fit of {points.n_points} points -> {out}")
         if report is not None:
             print(report.to_text())
-    if args.check and report is not None and report.passed is False:
+    if args.check and report is not None and report.written_passed is False:
         return EXIT_NOT_MET
     return 0

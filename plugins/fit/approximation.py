@@ -625,4 +625,10 @@ def fit_approximation(entities: list[Entity], options: ApproximationOptions) -> 
         notes=fitted.notes,
         details={**fitted.details, "parameterization": options.parameterization},
     )
-    return FitResult(surface=surface, report=report, distances=distances, method="approximation")
+    return FitResult(
+        surface=surface,
+        report=report,
+        distances=distances,
+        method="approximation",
+        points=points,
+    )

@@ -429,4 +429,11 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
         notes=notes,
         details=fitted.details,
     )
-    return FitResult(surface=surface, report=report, distances=distances, method="hybrid")
+    return FitResult(
+        surface=surface,
+        report=report,
+        distances=distances,
+        method="hybrid",
+        points=points,
+        subsets={"core": core_mask, "rim": ~core_mask},
+    )

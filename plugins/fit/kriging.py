@@ -437,4 +437,10 @@ def fit_kriging(entities: list[Entity], options: KrigingOptions) -> FitResult:
             "drift": list(options.drift_terms),
         },
     )
-    return FitResult(surface=surface, report=report, distances=distances, method="kriging")
+    return FitResult(
+        surface=surface,
+        report=report,
+        distances=distances,
+        method="kriging",
+        points=points,
+    )

@@ -33,14 +33,7 @@ def sigma(distances: FloatArray) -> float:
 
 
 def _subset(distances: FloatArray, epsilon: float | None) -> SubsetReport:
-    value = sigma(distances)
-    return SubsetReport(
-        sigma=value,
-        max_abs=float(np.abs(distances).max(initial=0.0)),
-        n=int(distances.shape[0]),
-        epsilon=epsilon,
-        passed=None if epsilon is None else bool(value < epsilon),
-    )
+    return SubsetReport.from_distances(distances, epsilon)
 
 
 def accuracy_report(

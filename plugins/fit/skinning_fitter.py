@@ -136,4 +136,10 @@ def fit_skinning(entities: list[Entity], options: SkinningOptions) -> FitResult:
             "points_per_section": [int(r.size) for r in rows],
         },
     )
-    return FitResult(surface=surface, report=report, distances=distances, method="skinning")
+    return FitResult(
+        surface=surface,
+        report=report,
+        distances=distances,
+        method="skinning",
+        points=points,
+    )

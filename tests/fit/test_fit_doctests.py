@@ -9,6 +9,7 @@ import pytest
 
 MODULES = [
     "geobrep.fitting",
+    "geobrep.geometry.distance",
     "geobrep.nurbs_eval",
     "geobrep.plugins.fit.approximation",
     "geobrep.plugins.fit.bending",
