@@ -208,7 +208,9 @@ class FitStep(StepOptions):
     """Fit a surface to each PointSet (or to the entities named in ``points``) with the
     fitter ``method``; ``options`` are the fitter's (e.g. ``epsilon``). The scene becomes the
     fitted surfaces (plus the points with ``keep_input``); ``check`` fails the file when a fit
-    does not meet ε."""
+    does not meet ε. A later write step whose format cannot hold NURBS writes a mesh whose σ
+    and max |d| are within 2 % of the surface's (at most ``max_triangles``); its accuracy is
+    noted, and ``check`` judges that mesh too."""
 
     kind: ClassVar[str] = "fit"
 
@@ -217,6 +219,8 @@ class FitStep(StepOptions):
     options: Options = Field(default_factory=dict)
     keep_input: bool = False
     check_epsilon: bool = Field(default=False, alias="check")
+    max_triangles: int = Field(default=1_000_000, ge=2)
+    """Bound on the mesh a write step makes of each fitted NURBS surface."""
 
     model_config = ConfigDict(populate_by_name=True)
 

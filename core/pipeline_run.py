@@ -26,11 +26,12 @@ from os import PathLike
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.capabilities import capability_losses
 from geobrep.conversion import expand, report_table, run_each
-from geobrep.entities import Entity, NurbsSurface, PointSet, PolyLine
+from geobrep.entities import Entity, NurbsSurface, PointSet, PolyLine, Surface
 from geobrep.errors import (
     EntityNotFoundError,
     FileAccessError,
@@ -56,6 +57,7 @@ from geobrep.pipeline import (
 from geobrep.scene import Scene
 
 if TYPE_CHECKING:
+    from geobrep.fitting import FitResult
     from geobrep.registry import Registries
 
 __all__ = [
@@ -274,6 +276,9 @@ class _Work:
     pending: list[tuple[int, str, Path, Scene, str, dict[str, Any]]] = field(default_factory=list)
     """Outputs to write once every step succeeded: (step, kind, target, scene, format, options)."""
     lost: list[str] = field(default_factory=list)
+    fits: list[tuple[NurbsSurface, FitResult, FitStep]] = field(default_factory=list)
+    """The NURBS surfaces fit steps made, with their results: a write step that tessellates one
+    refines its mesh against the fitted points and reports the mesh's accuracy."""
 
 
 def run_file(pipeline: Pipeline, source: Path, targets: tuple[Path, ...]) -> PipelineFileReport:
@@ -430,7 +435,10 @@ def _fit(step: FitStep, scene: Scene, work: _Work) -> Applied:
                     f"the {step.method} fit of {label!r} does not meet ε = {report.epsilon:g} "
                     f"(σ = {report.sigma:.4g})"
                 )
-        surfaces.append(result.surface.model_copy(update={"id": None}))
+        surface = result.surface.model_copy(update={"id": None})
+        if isinstance(surface, NurbsSurface):
+            work.fits.append((surface, result, step))
+        surfaces.append(surface)
     if step.keep_input:
         return scene.with_entities(*surfaces), notes
     return Scene(entities=surfaces, crs=scene.crs, name=scene.name), notes
@@ -466,24 +474,75 @@ def _write(step: WriteStep, scene: Scene, work: _Work) -> Applied:
     format_name = step.format_name(work.registries)
     caps = work.registries.formats.get(format_name).capabilities
     held = caps.entity_types
+    meshes: list[str] = []
     if step.tessellate and held and "NurbsSurface" not in held and "Surface" in held:
-        scene = _tessellated(scene)
+        scene, meshes = _tessellated(scene, work, target)
     losses = [f"{target.name}: {loss}" for loss in capability_losses(scene, caps)]
     work.lost.extend(losses)
     work.pending.append((work.number, step.kind, target, scene, format_name, dict(step.options)))
-    return scene, losses or [f"{target.name}: nothing lost"]
+    return scene, [*meshes, *(losses or [f"{target.name}: nothing lost"])]
 
 
-def _tessellated(scene: Scene) -> Scene:
+def _tessellated(scene: Scene, work: _Work, target: Path) -> tuple[Scene, list[str]]:
+    """The scene with its NURBS surfaces as meshes; a fitted surface's mesh is refined against
+    its points (see :meth:`geobrep.fitting.FitResult.tessellated`) and its accuracy noted."""
     if not scene.nurbs_surfaces:
-        return scene
+        return scene, []
     entities: list[Entity] = []
+    notes: list[str] = []
     for entity in scene.entities:
         if isinstance(entity, NurbsSurface):
-            tolerance = 1e-3 * float(entity.bounds.diagonal) if entity.bounds else None
-            entity = entity.tessellate(tolerance=tolerance).model_copy(update={"id": entity.id})
+            fitted = _fitted(entity, work)
+            if fitted is None:
+                tolerance = 1e-3 * float(entity.bounds.diagonal) if entity.bounds else None
+                mesh = entity.tessellate(tolerance=tolerance)
+            else:
+                mesh, note = _fitted_mesh(entity, *fitted, target)
+                notes.append(note)
+            entity = mesh.model_copy(update={"id": entity.id})
         entities.append(entity)
-    return scene.replace(entities=tuple(entities))
+    return scene.replace(entities=tuple(entities)), notes
+
+
+def _fitted(surface: NurbsSurface, work: _Work) -> tuple[FitResult, FitStep] | None:
+    """The fit that made ``surface``, when no step changed its geometry since."""
+    for fitted, result, step in work.fits:
+        if fitted is surface or (
+            fitted.control_points.shape == surface.control_points.shape
+            and np.array_equal(fitted.control_points, surface.control_points)
+            and np.array_equal(fitted.knots_u, surface.knots_u)
+            and np.array_equal(fitted.knots_v, surface.knots_v)
+            and np.array_equal(fitted.weights, surface.weights)
+        ):
+            return result, step
+    return None
+
+
+def _fitted_mesh(
+    surface: NurbsSurface, result: FitResult, step: FitStep, target: Path
+) -> tuple[Surface, str]:
+    written = result.tessellated(max_triangles=step.max_triangles)
+    mesh = written.written
+    accuracy = written.report.written if written.report is not None else None
+    assert mesh is not None
+    label = surface.name or surface.label
+    if accuracy is None or written.report is None:
+        return mesh, f"{target.name}: {label!r} written as a mesh of {mesh.n_vertices} vertices"
+    verdict = {True: "meets ε", False: "does not meet ε", None: "no ε"}[accuracy.passed]
+    agreement = "" if accuracy.agrees else ", not within 2 % of the surface's at max_triangles"
+    note = (
+        f"{target.name}: {label!r} written as a mesh of {accuracy.n_vertices} vertices: σ = "
+        f"{accuracy.sigma:.4g}, max |d| = {accuracy.max_abs:.4g} ({verdict}{agreement}; the "
+        f"surface: σ = {written.report.sigma:.4g}, max |d| = {written.report.max_abs:.4g})"
+    )
+    if step.check_epsilon and accuracy.passed is False:
+        raise OptionsError(
+            f"the mesh of the {step.method} fit {label!r} written to {target.name} does not meet "
+            f"ε = {accuracy.epsilon:g} (σ = {accuracy.sigma:.4g}; the surface's σ = "
+            f"{written.report.sigma:.4g}); raise max_triangles ({step.max_triangles}) for a "
+            "finer mesh"
+        )
+    return mesh, note
 
 
 _APPLY: dict[type[StepOptions], Callable[[Any, Scene, _Work], Applied]] = {

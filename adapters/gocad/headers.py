@@ -107,14 +107,38 @@ class PropertySpec:
 
 @dataclass
 class PropertyHeader:
-    """The property header of one element kind (vertices or cells)."""
+    """The property header of one element kind (vertices or cells).
+
+    Lines are collected as they come and applied together by :meth:`resolve` (when the first
+    data line sizes the tables), so that their order in the file does not matter.
+    """
 
     specs: list[PropertySpec] = field(default_factory=list)
     seen: dict[str, int] = field(default_factory=dict)  # keyword -> line
+    pending: list[tuple[str, str, int]] = field(default_factory=list)  # (keyword, text, line)
+    resolved: bool = False
 
     @property
     def n_values(self) -> int:
         return sum(spec.esize for spec in self.specs)
+
+    def resolve(self, warn: Any) -> None:
+        """Apply the collected lines: the names first (``PROPERTIES``, or ``PROPERTY_CLASSES``
+        when there is no ``PROPERTIES`` line), then every other line in file order."""
+        if self.resolved:
+            return
+        self.resolved = True
+        pending, self.pending = self.pending, []
+        names = [p for p in pending if p[0] == "PROPERTIES"]
+        if not names:
+            names = [p for p in pending if p[0] == "PROPERTY_CLASSES"][:1]
+            if names:
+                warn("PROPERTY_CLASSES without PROPERTIES names the properties", names[0][2])
+        for _, text, line in names:
+            _name_properties(self, text, line, warn)
+        for keyword, text, line in pending:
+            if keyword != "PROPERTIES":
+                _apply(self, keyword, text, line, warn)
 
 
 def _subclasses(tokens: list[str]) -> list[list[str]]:
@@ -127,19 +151,35 @@ def _subclasses(tokens: list[str]) -> list[list[str]]:
     return groups
 
 
+#: Keywords that change the layout of the value columns (ignored once the tables are sized).
+_LAYOUT_KEYWORDS = ("PROPERTIES", "ESIZES")
+
+
 def parse_property_line(
     header: PropertyHeader, keyword: str, text: str, line: int, warn: Any
 ) -> None:
-    """Apply one property-header line (``keyword`` without its TRGL_/SEG_/TETRA_ prefix)."""
-    tokens = split_tokens(text)[1:]
+    """One property-header line (``keyword`` without its TRGL_/SEG_/TETRA_ prefix): collected
+    until :meth:`PropertyHeader.resolve`, applied at once after it."""
     header.seen[keyword] = line
     if text.count('"') % 2:
         warn(f"{keyword} has an unbalanced quote; the rest of the line is one entry", line)
-    if keyword == "PROPERTIES":
-        if header.specs:
-            warn(f"a second PROPERTIES line replaces the first (line {line})", line)
-        header.specs = [PropertySpec(name=name or f"property_{i}") for i, name in enumerate(tokens)]
-        return
+    if not header.resolved:
+        header.pending.append((keyword, text, line))
+    elif keyword in _LAYOUT_KEYWORDS:
+        warn(f"{keyword} after the data lines is ignored (the value columns are fixed)", line)
+    else:
+        _apply(header, keyword, text, line, warn)
+
+
+def _name_properties(header: PropertyHeader, text: str, line: int, warn: Any) -> None:
+    tokens = split_tokens(text)[1:]
+    if header.specs:
+        warn(f"a second PROPERTIES line replaces the first (line {line})", line)
+    header.specs = [PropertySpec(name=name or f"property_{i}") for i, name in enumerate(tokens)]
+
+
+def _apply(header: PropertyHeader, keyword: str, text: str, line: int, warn: Any) -> None:
+    tokens = split_tokens(text)[1:]
     specs = header.specs
     if not specs:
         warn(f"{keyword} without PROPERTIES is ignored", line)

@@ -9,6 +9,7 @@ unrecoverable one a :class:`~geobrep.errors.FormatError` with the path and line.
 
 from __future__ import annotations
 
+import math
 import re
 import warnings
 from collections.abc import Iterator
@@ -16,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from geobrep.adapters.gocad.headers import (
     PROPERTY_KEYWORDS,
@@ -54,8 +56,25 @@ _CELL_PREFIX = {"TSurf": "TRGL_", "PLine": "SEG_", "TSolid": "TETRA_", "LightTSo
 _CELL_WIDTH = {"TSurf": 3, "PLine": 2, "TSolid": 4, "LightTSolid": 4, "Model3d": 3}
 _CELL_KEYWORD = {"TSurf": "TRGL", "PLine": "SEG", "TSolid": "TETRA", "LightTSolid": "TETRA"}
 _PART_KEYWORDS = {"TFACE", "3DFACE", "ILINE", "TVOLUME", "SUBVSET"}
+#: Keywords that start the data of an object (the first one sizes the vertex and cell tables).
+_DATA_KEYWORDS = {
+    "VRTX",
+    "PVRTX",
+    "ATOM",
+    "PATOM",
+    "SHAREDVRTX",
+    "SHAREDPVRTX",
+    "TRGL",
+    "SEG",
+    "TETRA",
+    "BSTONE",
+    "BORDER",
+    "MODEL",
+    *_PART_KEYWORDS,
+}
 _SKIP_BLOCKS = {
     "BEGIN_ATOM_REGION_INDICATORS": "END_ATOM_REGION_INDICATORS",
+    "BEGIN_VERTEX_REGION_INDICATORS": "END_VERTEX_REGION_INDICATORS",
     "PROPERTY_CN": "END_PROPERTY_CN",
 }
 
@@ -81,6 +100,8 @@ class GocadObject:
     cells: tuple[Any, ...] | None = None  # (ids, values, parts, lines) from CellTable.finish
     part_names: list[str] = field(default_factory=list)
     part_vertex_starts: list[int] = field(default_factory=list)
+    declared_parts: int = 0  # TFACE / ILINE / TVOLUME / SUBVSET lines (not implicit parts)
+    nonfinite: dict[tuple[str, int], list[int]] = field(default_factory=dict)  # -> [count, line]
     bstones: list[tuple[int, int]] = field(default_factory=list)  # (vertex id, line)
     borders: list[tuple[int, int, int, int]] = field(default_factory=list)  # (new, v0, v1, line)
     ctetra: list[tuple[int, str, list[str], int]] = field(default_factory=list)
@@ -352,11 +373,22 @@ class _Parser:
                 if not self._common(obj, item):
                     self._model3d_line(obj, item, model_state)
                 continue
-            if vertices is None and not self._common(obj, item):
-                vertices, cells = self._tables(obj)
             if vertices is None:
-                continue
-            if self._common(obj, item):
+                # Header part: the property header is only complete at the first data line.
+                if self._common(obj, item):
+                    continue
+                if keyword in _SKIP_BLOCKS:
+                    self._skip_block(keyword, item.number)
+                    continue
+                if keyword not in _DATA_KEYWORDS:
+                    self.warn(
+                        f"unknown keyword {keyword!r} in the header of a {obj.type}; line kept",
+                        item.number,
+                    )
+                    obj.extra_lines.append(item.text)
+                    continue
+                vertices, cells = self._tables(obj)
+            elif self._common(obj, item):
                 self.warn(f"{keyword} after the object's data lines", item.number)
                 continue
             part = self._element_line(obj, item, keyword, vertices, cells, part, model_state)
@@ -365,10 +397,14 @@ class _Parser:
             return
         if vertices is None:
             vertices, cells = self._tables(obj)
+        self._report_nonfinite(obj)
         obj.vertices = vertices.finish(self.error)
         obj.cells = cells.finish() if cells is not None else None
 
     def _tables(self, obj: GocadObject) -> tuple[VertexTable, CellTable | None]:
+        """The vertex and cell tables, sized by the (now complete) property headers."""
+        obj.point_header.resolve(self.warn)
+        obj.cell_header.resolve(self.warn)
         width = _CELL_WIDTH.get(obj.type)
         cells = CellTable(width, obj.cell_header.n_values) if width else None
         return VertexTable(obj.point_header.n_values), cells
@@ -403,7 +439,10 @@ class _Parser:
                 return part
             block = block.astype(np.float64, copy=False)
             ids = check_finite_ids(self.error, block, run.first, run.keyword)
-            values = block[:, 4:] if run.keyword == "PVRTX" else self._no_values(obj, run.count)
+            if run.keyword == "PVRTX":
+                values = self._finite(obj, "point", block[:, 4:], run.first)
+            else:
+                values = self._no_values(obj, run.count)
             vertices.add_block(ids, np.ascontiguousarray(block[:, 1:4]), values, run.first)
             return part
         expected = _CELL_KEYWORD.get(obj.type)
@@ -430,11 +469,52 @@ class _Parser:
             return part
         cells.add_block(
             np.ascontiguousarray(ids),
-            np.ascontiguousarray(block[:, cells.width :], dtype=np.float64),
+            np.ascontiguousarray(
+                self._finite(obj, "cell", block[:, cells.width :], run.first), dtype=np.float64
+            ),
             part,
             run.first,
         )
         return part
+
+    def _finite(
+        self, obj: GocadObject, kind: str, values: NDArray[np.float64], first_line: int
+    ) -> NDArray[np.float64]:
+        """Property values with every non-finite one (``inf``, ``1.#INF``, ``nan``) replaced by
+        its property's no-data value (NaN when it has none); counted for :meth:`_report`."""
+        if values.size == 0 or np.isfinite(values).all():
+            return values
+        header = obj.point_header if kind == "point" else obj.cell_header
+        spec_of = np.repeat(np.arange(len(header.specs)), [s.esize for s in header.specs])
+        no_data = np.array(
+            [np.nan if s.no_data is None else s.no_data for s in header.specs], dtype=np.float64
+        )[spec_of]
+        with np.errstate(invalid="ignore"):
+            is_no_data = (values == no_data) | (np.isnan(values) & np.isnan(no_data))
+        bad = ~np.isfinite(values) & ~is_no_data
+        if not bad.any():
+            return values
+        rows, columns = np.nonzero(bad)
+        counts = np.bincount(spec_of[columns], minlength=len(header.specs))
+        for index in np.flatnonzero(counts).tolist():
+            entry = obj.nonfinite.setdefault((kind, index), [0, first_line + int(rows[0])])
+            entry[0] += int(counts[index])
+        return np.where(bad, no_data, values)
+
+    def _report_nonfinite(self, obj: GocadObject) -> None:
+        for (kind, index), (count, line) in sorted(obj.nonfinite.items()):
+            header = obj.point_header if kind == "point" else obj.cell_header
+            spec = header.specs[index]
+            into = (
+                "NaN (it has no no-data value)"
+                if spec.no_data is None
+                else f"its no-data value {spec.no_data!r}"
+            )
+            self.warn(
+                f"{kind} property {spec.name!r}: {count} non-finite value(s) (inf, nan) "
+                f"replaced by {into}; the first on this line",
+                line,
+            )
 
     def _no_values(self, obj: GocadObject, n: int) -> Any:
         return np.full((n, obj.point_header.n_values), np.nan)
@@ -478,6 +558,8 @@ class _Parser:
                     )
                 xyz = (parse_float(tokens[2]), parse_float(tokens[3]), parse_float(tokens[4]))
                 values = [parse_float(t) for t in tokens[5:count]] if keyword == "PVRTX" else None
+                if values is not None and not all(map(math.isfinite, values)):
+                    values = self._finite(obj, "point", np.array([values]), number)[0].tolist()
                 if values is None and n_values:
                     values = [np.nan] * n_values
                 vertices.add(parse_int(tokens[1]), xyz, None, values, flag, number)
@@ -495,6 +577,8 @@ class _Parser:
                             number,
                         )
                     values = [parse_float(t) for t in tokens[3 : 3 + n_values]]
+                    if not all(map(math.isfinite, values)):
+                        values = self._finite(obj, "point", np.array([values]), number)[0].tolist()
                 vertices.add(parse_int(tokens[1]), None, parse_int(tokens[2]), values, flag, number)
             elif keyword in _PART_KEYWORDS:
                 name = item.text[len(keyword) :].strip()
@@ -503,6 +587,7 @@ class _Parser:
                         self._tsolid_model_line(obj, item, keyword, model_state)
                     else:
                         part = self._new_part(obj, _unquote(name), vertices)
+                        obj.declared_parts += 1
                 else:
                     self.warn(f"{keyword} is not used in a {obj.type}; ignored", number)
             elif cells is not None and keyword == _CELL_KEYWORD.get(obj.type):
@@ -519,15 +604,24 @@ class _Parser:
                     self.warn(f"{keyword} has extra entries; ignored", number)
                 ids = [parse_int(t) for t in tokens[1 : 1 + width]]
                 values = [parse_float(t) for t in tokens[1 + width : 1 + width + n_cell]]
+                if not all(map(math.isfinite, values)):
+                    values = self._finite(obj, "cell", np.array([values]), number)[0].tolist()
                 cells.add(ids, values, part, number)
             elif keyword == "# CTETRA" or (keyword == "#" and item.text.startswith("# CTETRA")):
                 if cells is None or cells.count == 0:
                     raise self.error("'# CTETRA' before any TETRA", number)
-                parts = tokens[2:]
+                # entries like -(boundary)"fracture 1": quotes do not end an entry
+                parts = _CTETRA_ENTRY.findall(item.text)[2:]
+                if len(parts) > 5:
+                    raise self.error(
+                        f"'# CTETRA' needs a region and 4 face entries, found {len(parts)} entries",
+                        number,
+                    )
                 if obj.ctetra and obj.ctetra[-1][0] == cells.count - 1:
                     self.warn("a second '# CTETRA' line for one TETRA replaces the first", number)
                     obj.ctetra.pop()
-                obj.ctetra.append((cells.count - 1, parts[0] if parts else "", parts[1:5], number))
+                region = _unquote(parts[0]) if parts else ""
+                obj.ctetra.append((cells.count - 1, region, parts[1:5], number))
             elif keyword == "BSTONE":
                 if len(tokens) < 2:
                     raise self.error("BSTONE needs a vertex id", number)
@@ -761,6 +855,7 @@ _BODY_START = {
 
 
 _NUMBERS_ONLY = re.compile(r"[-+0-9.eE\s]+")
+_CTETRA_ENTRY = re.compile(r'(?:[^\s"]+|"[^"]*")+')
 
 
 def _unquote(text: str) -> str:

@@ -2,9 +2,11 @@
 
 * TSurf → :class:`Surface` with one patch per TFACE; PLine → :class:`PolyLine` with one part per
   ILINE (split where its SEGs do not chain); VSet → :class:`PointSet`; TSolid / LightTSolid →
-  :class:`TetMesh` with one region per TVOLUME (plus one :class:`Surface` per SURFACE of its
-  MODEL section); Model3d → its member TSurfs, ``scene.topology`` (one patch per TFACE) and a
-  :class:`Block` per REGION; groups → :class:`~geobrep.scene.Group` s.
+  :class:`TetMesh` with one region per TVOLUME, or, without TVOLUMEs, per volume enclosed by the
+  faces ``# CTETRA`` and the MODEL triangles put on surfaces, named by MODEL_REGION seeds (plus
+  one :class:`Surface` per SURFACE of its MODEL section); Model3d → its member TSurfs,
+  ``scene.topology`` (one patch per TFACE) and a :class:`Block` per REGION; groups →
+  :class:`~geobrep.scene.Group` s.
 * ``ZPOSITIVE Depth`` negates z (triangle winding is kept); the scene's CRS records it.
 * Everything else the file says is kept in ``metadata["gocad"]`` so that a writer can restore it.
 """
@@ -24,6 +26,8 @@ from geobrep.adapters.gocad.model3d import attach_model3d
 from geobrep.adapters.gocad.objects import gocad_section
 from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.adapters.gocad.parser import GROUP_TYPES, GocadObject, GocadWarning, parse_source
+from geobrep.adapters.gocad.regions import TetFaces, root_vertices
+from geobrep.adapters.gocad.tables import ResolvedVertices
 from geobrep.crs import CRS
 from geobrep.entities import Entity, PointSet, PolyLine, Surface, TetMesh
 from geobrep.errors import EntityValidationError, FormatError, TopologyError
@@ -337,7 +341,9 @@ class _Builder:
                 self._polyline(obj, xyz, index, parts, point_data, cell_data, fields)
             )
         else:
-            self._tsolid(obj, xyz, index, parts, names, point_data, cell_data, fields, lookup)
+            self._tsolid(
+                obj, xyz, index, parts, names, point_data, cell_data, fields, lookup, vertices
+            )
 
     def _hints(self, obj: GocadObject, lookup: Any, fields: dict[str, Any]) -> None:
         """BSTONE / BORDER lines as vertex indices in ``metadata["gocad"]``."""
@@ -413,24 +419,40 @@ class _Builder:
         cell_data: dict[str, Property],
         fields: dict[str, Any],
         lookup: Any,
+        vertices: ResolvedVertices,
     ) -> None:
         gocad = fields["metadata"]["gocad"]
+        model = obj.model
+        codes: NDArray[np.int64] | None = None
+        ctetra_names: list[tuple[int, str]] = []
         if obj.ctetra:
-            codes, surfaces, regions = _ctetra_codes(obj, tetra.shape[0], self.error)
+            codes, surfaces, ctetra_names = _ctetra_codes(obj, tetra.shape[0], self.error)
             cell_data[CTETRA_PROPERTY] = Property(
                 values=codes,
                 description="GOCAD '# CTETRA' faces: 0 none, +k/-k side of surface k-1",
                 metadata={"gocad": {"surfaces": surfaces}},
             )
-            named = np.array([names[p] if p < len(names) else "" for p in np.unique(parts)])
-            expected = dict(zip(np.unique(parts).tolist(), named.tolist(), strict=True))
-            mismatched = [r for r in regions if r[1] != expected.get(int(parts[r[0]]), r[1])]
-            if mismatched:
-                gocad["ctetra_regions"] = [[int(c), str(n)] for c, n in regions]
-                self.warn(f"# CTETRA regions differ from TVOLUME parts in {obj.name!r}", obj.line)
-        model = obj.model
         if model.get("regions"):
             gocad["model_regions"] = model["regions"]
+        if (codes is not None or model.get("regions")) and tetra.shape[0]:
+            faces = TetFaces(tetra, root_vertices(vertices.atom_of))
+            seeds = self._seeds(obj, faces, xyz, lookup)
+            if not obj.declared_parts:  # no TVOLUME: the regions are what faces and seeds say
+                parts, names = self._regions_from_faces(obj, faces, codes, seeds, lookup)
+            else:
+                self._check_seeds(obj, seeds, parts, names)
+        if ctetra_names:
+            region_of = np.array([names[p] if p < len(names) else "" for p in parts.tolist()])
+            mismatched = [(c, n) for c, n in ctetra_names if n != region_of[c]]
+            if mismatched:
+                gocad["ctetra_regions"] = [[int(c), str(n)] for c, n in ctetra_names]
+                self.warn(
+                    f"{len(mismatched)} '# CTETRA' region name(s) differ from the regions of "
+                    f"{obj.name!r} (first: tetrahedron {mismatched[0][0]} says "
+                    f"{mismatched[0][1]!r}, its region is {region_of[mismatched[0][0]]!r}); "
+                    "kept in metadata['gocad']['ctetra_regions']",
+                    obj.line,
+                )
         tet_id = self.next_id()
         self.entities.append(
             TetMesh(
@@ -448,6 +470,103 @@ class _Builder:
                 self.warn(f"MODEL surface {surface['name']!r} has no TFACE; skipped", obj.line)
                 continue
             self._tsolid_surface(obj, surface, xyz, lookup, tet_id)
+
+    def _seeds(
+        self, obj: GocadObject, faces: TetFaces, xyz: NDArray[np.float64], lookup: Any
+    ) -> list[tuple[str, int]]:
+        """``(name, tetrahedron)`` of each MODEL_REGION whose seed face is found."""
+        tfaces = {
+            t["id"]: t for surface in obj.model.get("surfaces", []) for t in surface["tfaces"]
+        }
+        found: list[tuple[str, int]] = []
+        for name, signed in obj.model.get("regions", []):
+            tface = tfaces.get(abs(signed))
+            what = f"MODEL_REGION {name!r} {signed:+d}"
+            if tface is None or tface["key"] is None or signed == 0:
+                self.warn(f"{what}: no TFACE {abs(signed)} with KEYVERTICES; ignored", obj.line)
+                continue
+            ids, line = tface["key"]
+            key = lookup.require(
+                np.asarray([ids], dtype=np.int64), np.asarray([line]), "KEYVERTICES", self.error
+            )[0]
+            cell = faces.seed(xyz, key, 1 if signed > 0 else -1)
+            if cell is None:
+                self.warn(
+                    f"{what}: no tetrahedron on that side of TFACE {abs(signed)}'s key "
+                    "triangle; ignored",
+                    line,
+                )
+                continue
+            found.append((str(name), cell))
+        return found
+
+    def _regions_from_faces(
+        self,
+        obj: GocadObject,
+        faces: TetFaces,
+        codes: NDArray[np.int64] | None,
+        seeds: list[tuple[str, int]],
+        lookup: Any,
+    ) -> tuple[NDArray[np.int64], tuple[str, ...]]:
+        """Regions as connected sets of tetrahedra separated by model-surface faces (``#
+        CTETRA`` codes and ``MODEL`` triangles), named by their MODEL_REGION seeds, else by the
+        ``# CTETRA`` region most of their tetrahedra name; sets with one name are one region."""
+        barrier = codes != 0 if codes is not None else np.zeros((faces.n_cells, 4), dtype=bool)
+        triangles = [
+            (tri, line)
+            for surface in obj.model.get("surfaces", [])
+            for tface in surface["tfaces"]
+            for tri, line in tface["triangles"]
+        ]
+        if triangles:
+            ids = np.asarray([t for t, _ in triangles], dtype=np.int64)
+            lines = np.asarray([line for _, line in triangles], dtype=np.int64)
+            barrier = barrier | faces.on_triangles(lookup.require(ids, lines, "TRGL", self.error))
+        count, component = faces.components(barrier)
+        named: dict[int, str] = {}
+        for name, cell in seeds:
+            c = int(component[cell])
+            if named.setdefault(c, name) != name:
+                self.warn(
+                    f"MODEL_REGION {name!r} seeds the region already named {named[c]!r} "
+                    "(their tetrahedra are connected); it keeps that name",
+                    obj.line,
+                )
+        order = [n for n in dict.fromkeys(named.values())]
+        if len(named) < count:
+            majority = _majority_names(obj, component, count)
+            for c in range(count):
+                if c not in named:
+                    named[c] = majority[c] or f"region_{c}"
+                    if not majority[c]:
+                        self.warn(
+                            f"a connected set of {int((component == c).sum())} tetrahedra of "
+                            f"{obj.name!r} has no MODEL_REGION seed nor '# CTETRA' region; "
+                            f"named {named[c]!r}",
+                            obj.line,
+                        )
+        order += [n for n in dict.fromkeys(named[c] for c in range(count)) if n not in order]
+        index = {name: k for k, name in enumerate(order)}
+        label_of = np.array([index[named[c]] for c in range(count)], dtype=np.int64)
+        return label_of[component], tuple(order)
+
+    def _check_seeds(
+        self,
+        obj: GocadObject,
+        seeds: list[tuple[str, int]],
+        parts: NDArray[np.int64],
+        names: tuple[str, ...],
+    ) -> None:
+        """With TVOLUMEs, the regions are the TVOLUMEs; a seed in another one is reported."""
+        for name, cell in seeds:
+            part = int(parts[cell])
+            own = names[part] if part < len(names) else ""
+            if own != name:
+                self.warn(
+                    f"MODEL_REGION {name!r} seeds tetrahedron {cell} of TVOLUME {own!r}; "
+                    "the TVOLUMEs are kept as the regions",
+                    obj.line,
+                )
 
     def _tsolid_surface(
         self,
@@ -509,6 +628,19 @@ class _Builder:
                 },
             )
         )
+
+
+def _majority_names(obj: GocadObject, component: NDArray[np.int64], count: int) -> list[str]:
+    """For each connected set, the ``# CTETRA`` region most of its tetrahedra name ("" if
+    none)."""
+    if not obj.ctetra:
+        return [""] * count
+    cells = np.array([c for c, _, _, _ in obj.ctetra], dtype=np.int64)
+    labels, which = np.unique([r for _, r, _, _ in obj.ctetra], return_inverse=True)
+    votes = np.zeros((count, labels.shape[0]), dtype=np.int64)
+    np.add.at(votes, (component[cells], which), 1)
+    best = votes.argmax(axis=1)
+    return [str(labels[b]) if votes[c, b] else "" for c, b in enumerate(best.tolist())]
 
 
 def _ctetra_codes(

@@ -3,7 +3,8 @@
 ``geobrep convert IN OUT`` converts one file (formats from the extensions);
 ``geobrep convert IN... --to FMT -o DIR [--jobs N]`` converts many (paths or glob patterns) to
 ``DIR/<stem>.<ext>``. Each file's losses are reported; the exit code is 1 if any file failed,
-with every failure listed.
+with every failure listed. ``--verify`` reads each written file back: a file that lacks
+something its report does not list as lost fails.
 """
 
 from __future__ import annotations
@@ -51,6 +52,11 @@ def add_parser(subparsers: Any) -> None:
         dest="read_format",
         metavar="NAME",
         help="input format, when the extension is not enough",
+    )
+    parser.add_argument(
+        "--verify",
+        action="store_true",
+        help="read each written file back; a file missing what its report keeps fails",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the reports as JSON")
@@ -105,6 +111,7 @@ def run(args: argparse.Namespace) -> int:
         client=args.dask,
         read_format=args.read_format,
         progress=progress,
+        verify=args.verify,
     )
     _print(summary, args.json)
     return 0 if summary.ok else 1

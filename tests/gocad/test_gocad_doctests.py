@@ -13,6 +13,7 @@ MODULES = [
     "geobrep.adapters.gocad.lexer",
     "geobrep.adapters.gocad.numbers",
     "geobrep.adapters.gocad.options",
+    "geobrep.adapters.gocad.regions",
 ]
 
 

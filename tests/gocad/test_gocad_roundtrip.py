@@ -204,7 +204,8 @@ def test_awkward_floats_survive_the_bulk_paths_bit_for_bit(tmp_path: Path) -> No
     back = read_quietly(path).surfaces[0]
     assert arrays_identical(back.vertices, vertices)
     assert np.array_equal(back.faces, faces)
-    for name, expected in (("a", values[:, 0]), ("b", values[:, 1])):
+    read_as = np.where(np.isfinite(values), values, np.nan)  # non-finite values: no data
+    for name, expected in (("a", read_as[:, 0]), ("b", read_as[:, 1])):
         assert arrays_identical(back.point_data[name].values, expected)
     for name in ("c", "zone"):
         assert arrays_identical(back.cell_data[name].values, surface.cell_data[name].values)
