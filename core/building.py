@@ -25,9 +25,10 @@ def build_blocks(scene: Scene, builder: str = "blocks", **options: Any) -> Scene
     Existing blocks and topology are replaced. ``builder`` names a registered builder; the
     other keywords are its options (for ``blocks``: ``tolerance``, ``relative_tolerance``,
     ``free_borders``, ``check_conformity``, ``gap_tolerance``, ``relative_gap_tolerance``,
-    ``angle_tolerance``, ``validate``, ``surfaces``; see ``docs/blocks.md``). Non-conformal input
-    raises :class:`~geobrep.errors.TopologyError` with the places at fault; the report of the
-    ``blocks`` builder is in ``result.metadata["block_report"]``.
+    ``angle_tolerance``, ``validate``, ``surfaces``; see ``docs/blocks.md``; by default the
+    tolerance follows the precision the coordinates carry). Non-conformal input raises
+    :class:`~geobrep.errors.TopologyError` with the places at fault and the options that relax
+    the check; the report of the ``blocks`` builder is in ``result.metadata["block_report"]``.
 
     >>> import geobrep
     >>> model = geobrep.datasets.faulted_layer_cake()

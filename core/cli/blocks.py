@@ -33,11 +33,16 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("output", metavar="OUT", help="output file (e.g. .geobrep or .ml)")
     parser.add_argument("--format", help="output format name, when the extension is not enough")
     parser.add_argument("--input-format", help="input format name for every input file")
-    parser.add_argument("--tolerance", type=float, help="vertex merge distance (model units)")
+    parser.add_argument(
+        "--tolerance",
+        type=float,
+        help="vertex merge and contact distance (model units; default: 4 quanta of the "
+        "precision the coordinates carry, e.g. float32 or 2 decimals)",
+    )
     parser.add_argument(
         "--relative-tolerance",
         type=float,
-        help="vertex merge distance relative to the model diagonal (default 1e-7)",
+        help="vertex merge and contact distance relative to the model diagonal",
     )
     parser.add_argument(
         "--free-borders",

@@ -43,6 +43,8 @@ FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
 _MAX_LISTED = 8
+#: Contacts within this many tolerances of a line two surfaces share are no defect.
+ARC_MARGIN = 3.0
 #: Triangle pairs tested at once (bounds the (K, 3, 3, 3) temporaries).
 _BATCH = 1 << 15
 #: Corner j + 1 of corner j (edge j runs from one to the other).
@@ -62,7 +64,7 @@ class NonConformity:
 class NonConformalError(TopologyError):
     """The surfaces are not conformal; ``defects`` lists where (model coordinates)."""
 
-    def __init__(self, defects: list[NonConformity]) -> None:
+    def __init__(self, defects: list[NonConformity], hint: str = "") -> None:
         self.defects = defects
         grouped: dict[tuple[str, tuple[str, str]], list[NonConformity]] = defaultdict(list)
         for defect in defects:
@@ -78,7 +80,7 @@ class NonConformalError(TopologyError):
         more = len(grouped) - _MAX_LISTED
         tail = f"; and {more} more" if more > 0 else ""
         super().__init__(
-            f"non-conformal input: {len(defects)} defect(s): " + "; ".join(parts) + tail
+            f"non-conformal input: {len(defects)} defect(s): " + "; ".join(parts) + tail + hint
         )
 
 
@@ -350,6 +352,58 @@ def _vertex_triangle_distance(points: FloatArray, triangles: FloatArray) -> Floa
     return distance
 
 
+def _shared_edges(soup: Soup, rows: IntArray, other_surface: IntArray) -> BoolArray:
+    """(K, 3): whether edge ``j`` (corner j to j + 1) of triangle ``rows[k]`` is also an edge of
+    a triangle of surface ``other_surface[k]``."""
+    n_vertices = np.int64(soup.vertices.shape[0])
+    n_surfaces = np.int64(len(soup.surfaces))
+    tri = soup.triangles
+    low = np.minimum(tri, tri[:, _NEXT]).reshape(-1)
+    high = np.maximum(tri, tri[:, _NEXT]).reshape(-1)
+    known = np.unique((low * n_vertices + high) * n_surfaces + np.repeat(soup.triangle_surface, 3))
+    mine = tri[rows]
+    edge = np.minimum(mine, mine[:, _NEXT]) * n_vertices + np.maximum(mine, mine[:, _NEXT])
+    key = edge * n_surfaces + other_surface[:, None]
+    place = np.minimum(np.searchsorted(known, key), max(known.size - 1, 0))
+    return np.asarray(known[place] == key) if known.size else np.zeros(key.shape, np.bool_)
+
+
+def _away_from(
+    corners: FloatArray, shared: BoolArray, margin: float
+) -> tuple[FloatArray, BoolArray]:
+    """The triangles (K, 3, 3) without the strip of width ``margin`` along their ``shared``
+    edges (K, 3: edge j runs from corner j to j + 1), and which ones nothing is left of."""
+    side = corners[:, _NEXT] - corners  # side j
+    twice_area = np.linalg.norm(np.cross(side[:, 0], -side[:, 2]), axis=1)
+    length = np.linalg.norm(side, axis=2)
+    # Side j is opposite corner j + 2; that corner's barycentric coordinate must reach t.
+    with np.errstate(divide="ignore", invalid="ignore"):
+        reach = np.where(shared, margin * length / twice_area[:, None], 0.0)
+    t = np.zeros_like(reach)
+    t[:, [2, 0, 1]] = reach  # t[:, m]: for corner m (opposite side m + 1)
+    gone = ~(t.sum(axis=1) < 1.0)
+    weights = np.repeat(t[:, None, :], 3, axis=1)  # (K, new corner, old corner)
+    for m in range(3):
+        weights[:, m, m] = 1.0 - t.sum(axis=1) + t[:, m]
+    return np.einsum("kmc,kcx->kmx", weights, corners), gone
+
+
+def _along_shared_lines(
+    soup: Soup, corners: FloatArray, i: IntArray, j: IntArray, tol: float
+) -> BoolArray:
+    """Pairs that meet only within ``ARC_MARGIN × tol`` of edges the two surfaces share: a
+    vertex of one surface beside the line where it meets the other (a sliver triangle sealing
+    a vertex the other surface does not have, moved off that line by rounding) is no defect."""
+    surface = soup.triangle_surface
+    margin = ARC_MARGIN * tol
+    first, gone_first = _away_from(corners[i], _shared_edges(soup, i, surface[j]), margin)
+    second, gone_second = _away_from(corners[j], _shared_edges(soup, j, surface[i]), margin)
+    benign = gone_first | gone_second
+    rest = np.flatnonzero(~benign)
+    benign[rest] = ~triangles_intersect(first[rest], second[rest], tol)
+    return benign
+
+
 def _crossings(soup: Soup, tol: float) -> list[NonConformity]:
     local = soup.local(soup.vertices)
     corners = local[soup.triangles]
@@ -364,6 +418,10 @@ def _crossings(soup: Soup, tol: float) -> list[NonConformity]:
     i, j = i[apart], j[apart]
     hit = triangles_intersect(corners[i], corners[j], tol)
     i, j = i[hit], j[hit]
+    if i.size == 0:
+        return []
+    real = ~_along_shared_lines(soup, corners, i, j, tol)
+    i, j = i[real], j[real]
     if i.size == 0:
         return []
     touch = np.minimum(
@@ -449,8 +507,24 @@ def _gaps(soup: Soup, split: PatchSplit, gap_tolerance: float, tol: float) -> li
     return defects
 
 
+def _hint(soup: Soup, defects: list[NonConformity], gap_tolerance: float) -> str:
+    """Which tolerance the check used, where it came from, and the options that change it."""
+    if soup.tolerance_source == "precision" and soup.precision is not None:
+        origin = f"{soup.precision.source} coordinates, precision {soup.precision.quantum:.3g}"
+    else:
+        origin = f"option {soup.tolerance_source}"
+    text = (
+        f" (merge/contact tolerance {soup.tolerance:.3g}, from {origin}; if the defects are "
+        "rounding, relax the check with relative_tolerance= / --relative-tolerance or "
+        "tolerance= / --tolerance"
+    )
+    if any(d.kind == "gap" for d in defects):
+        text += f"; gaps are sought within gap_tolerance= / --gap-tolerance ({gap_tolerance:.3g})"
+    return text + "; check_conformity=False / --no-conformity-check skips it)"
+
+
 def check_conformity(soup: Soup, split: PatchSplit, gap_tolerance: float) -> None:
     """Raise :class:`NonConformalError` when surfaces cross, touch or leave gaps."""
     defects = _crossings(soup, soup.tolerance) + _gaps(soup, split, gap_tolerance, soup.tolerance)
     if defects:
-        raise NonConformalError(defects)
+        raise NonConformalError(defects, _hint(soup, defects, gap_tolerance))

@@ -15,8 +15,11 @@ FreeBorders = Literal["internal", "remove", "error"]
 class BlockBuilderOptions(BaseModel):
     """How the ``blocks`` builder turns conformal surfaces into blocks.
 
-    * ``tolerance`` — absolute distance under which vertices are merged (default:
-      ``relative_tolerance`` × the diagonal of the surfaces' bounding box).
+    * ``tolerance`` — absolute distance under which vertices are merged and surfaces count as
+      touching; else ``relative_tolerance`` × the diagonal of the surfaces' bounding box; else
+      (the default) a few quanta of the precision the coordinates carry — float32, a number of
+      decimals or significant digits, or float64 — within [1e-9, 1e-4] × the diagonal
+      (:mod:`geobrep.plugins.blocks.precision`).
     * ``free_borders`` — ``"internal"`` (default): a patch with a free border inside a block is an
       internal surface (listed with both sides, like GOCAD's ``+k -k``), and patches outside the
       model or floating alone are dangling, removed and reported; ``"remove"``: the paper's rule,
@@ -33,7 +36,7 @@ class BlockBuilderOptions(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
 
     tolerance: float | None = Field(default=None, ge=0.0)
-    relative_tolerance: float = Field(default=1e-7, ge=0.0, lt=1e-2)
+    relative_tolerance: float | None = Field(default=None, ge=0.0, lt=1e-2)
     free_borders: FreeBorders = "internal"
     check_conformity: bool = True
     gap_tolerance: float | None = Field(default=None, ge=0.0)

@@ -63,6 +63,16 @@ class BlockReport(_ReportModel):
     retried_arcs: int
     passes: int
     tolerance: float
+    tolerance_source: str = Field(
+        default="precision",
+        description='"tolerance", "relative_tolerance" or "precision" (from the coordinates)',
+    )
+    precision: float | None = Field(
+        default=None, description="rounding quantum of the coordinates (model units)"
+    )
+    precision_source: str | None = Field(
+        default=None, description='"float32", "2 decimals", "8 significant digits", "float64"'
+    )
     gap_tolerance: float
     stage_seconds: dict[str, float]
     validated: bool

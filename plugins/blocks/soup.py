@@ -1,8 +1,9 @@
 """The triangle soup: every surface's triangles over one table of merged (welded) vertices.
 
 Surfaces of a conformal model meet along shared vertices; files store each surface with its own
-copy of them, so colocated vertices are merged first, within a tolerance relative to the model
-size. Triangles that collapse in the merge (two corners welded together) are dropped and
+copy of them, so colocated vertices are merged first, within a tolerance (by default a few
+quanta of the precision the coordinates carry: :mod:`.precision`).
+Triangles that collapse in the merge (two corners welded together) are dropped and
 counted. Quads are split along their 0-2 diagonal.
 """
 
@@ -17,6 +18,7 @@ from geobrep.entities import Surface
 from geobrep.errors import DegenerateGeometryError
 from geobrep.geometry import mesh
 from geobrep.geometry.bbox import column_extremes
+from geobrep.plugins.blocks.precision import Precision, data_tolerance, measure_precision
 
 __all__ = ["Soup", "build_soup"]
 
@@ -46,6 +48,8 @@ class Soup:
     tolerance: float
     centre: FloatArray
     diagonal: float
+    precision: Precision | None = None
+    tolerance_source: str = "tolerance"
 
     @property
     def n_triangles(self) -> int:
@@ -70,9 +74,12 @@ class Soup:
 
 
 def build_soup(
-    surfaces: tuple[Surface, ...], tolerance: float | None, relative_tolerance: float
+    surfaces: tuple[Surface, ...], tolerance: float | None, relative_tolerance: float | None
 ) -> Soup:
     """Merge the surfaces' vertices within the tolerance and collect their triangles.
+
+    The tolerance is ``tolerance``, else ``relative_tolerance`` × the bounding-box diagonal, else
+    (both ``None``) the one the coordinates' precision gives (:func:`.precision.data_tolerance`).
 
     >>> import geobrep
     >>> scene = geobrep.datasets.faulted_layer_cake()
@@ -90,8 +97,13 @@ def build_soup(
     lower, upper = column_extremes(all_vertices)
     centre = 0.5 * (lower + upper)
     diagonal = float(np.linalg.norm(upper - lower))
-    if tolerance is None:
-        tolerance = relative_tolerance * diagonal
+    precision = None
+    rule = "tolerance"
+    if tolerance is None and relative_tolerance is not None:
+        tolerance, rule = relative_tolerance * diagonal, "relative_tolerance"
+    elif tolerance is None:
+        precision = measure_precision(all_vertices)
+        tolerance, rule = data_tolerance(precision, diagonal), "precision"
     merged, inverse = mesh.merge_close_vertices(all_vertices, tolerance)
 
     triangle_parts: list[IntArray] = []
@@ -122,4 +134,6 @@ def build_soup(
         tolerance=float(tolerance),
         centre=centre,
         diagonal=diagonal,
+        precision=precision,
+        tolerance_source=rule,
     )
