@@ -504,16 +504,17 @@ def fit(
 
 
 def demo_stage(ctx: DemoContext) -> None:
-    """Demo: fit the built-in scattered points with the hybrid method and report the accuracy."""
+    """Demo: fit the built-in scattered points with the hybrid method, write the surface with a
+    mesh of it, and report the accuracy of both."""
     from geobrep import datasets
     from geobrep.io import write
 
     points = datasets.scattered_points()
-    result = fit(points, method="hybrid", epsilon=0.5)
+    result = fit(points, method="hybrid", epsilon=0.5).tessellated()
     surface = result.surface
     entities: list[Entity] = [surface, points]
-    if isinstance(surface, NurbsSurface):
-        entities.append(surface.tessellate(resolution=300).replace(name=f"{surface.name} mesh"))
+    if result.written is not None:  # as accurate as the surface (report.written says how much)
+        entities.append(result.written.replace(name=f"{surface.name} mesh"))
     path = ctx.output / "fitted_surface.geobrep"
     write(entities, path)
     report = result.report

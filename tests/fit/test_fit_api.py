@@ -222,6 +222,8 @@ def test_demo_stage(tmp_path: Path, layer_cake: Scene) -> None:
     demo_stage(ctx)
     assert ctx.summary["fit"]["passed"] is True
     assert ctx.summary["fit"]["subsets"]["core"]["n"] == 300
+    assert ctx.summary["fit"]["written"]["agrees"] is True  # the mesh is as accurate
+    assert any("accuracy of the mesh written" in line for line in ctx.lines)
     assert any("hybrid NURBS fit of 600 survey points" in line for line in ctx.lines)
     written = geobrep.read(tmp_path / "fitted_surface.geobrep")
     kinds = sorted(type(e).__name__ for e in written.entities)
