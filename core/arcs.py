@@ -1,26 +1,33 @@
-"""Rebuild the corners and arcs of a B-Rep from its surface patches.
+"""Corners and arcs of a B-Rep from its patches: the one rule the GOCAD reader, the block builder
+and the sample model share.
 
-An **arc** is a maximal chain of patch-boundary edges shared by the *same set* of patches (a
-horizon–fault intersection is shared by the horizon patch that ends there and the two fault
-patches it separates; a free fault tip by the fault patch alone). A **corner** is a vertex
-where that set changes, where more than two chains meet, where a chain ends, where the set
-of patches touching the chain grows (a free fault border meeting a horizon), or one given as a
-hint (``extra_corners``, e.g. GOCAD BSTONEs). A closed chain without any corner gets one corner
-at its lowest vertex.
+An **arc edge** is an edge where the patches do not simply continue: any edge that is not used by
+exactly two triangles of one patch (the block builder, which finds the patches itself, also
+cuts them at orientation seams, so there a seam is an arc edge too). Every arc edge has the
+*multiset* of the patches of its triangles (``{H, F1, F2}`` where a horizon ends on a fault;
+``{B, B, H}`` where a horizon ends inside a box it does not cut). A vertex of arc edges is a
+**corner** when
 
-The computation is vectorised:
+1. it does not join exactly two arc edges (three or more arcs meet there, or a chain ends);
+2. its two arc edges have different patch multisets;
+3. the set of patches *touching* the chain changes there: of two neighbouring chain vertices
+   touched by different sets of patches, the one touched by more (both when as many) is a
+   corner (a free fault border crossing a horizon at one vertex);
+4. the source marks it as one (``extra_corners``: GOCAD ``BSTONE`` lines, which the GOCAD
+   writer puts at every corner so that a written model reads back with the same corners);
+5. it is the lowest vertex — in (x, y, z) lexicographic order — of a closed chain that no
+   rule above gave a corner.
 
-1. the vertices of every patch are joined across surfaces within ``tolerance`` (coincident
-   vertices of different surfaces often differ in their last digits);
-2. a patch's boundary edges are the edges used by exactly one of its triangles;
-3. every boundary edge gets the signature of its patch set (two 64-bit hashes and a count);
-4. corner vertices are found from edge counts, signature minima/maxima per vertex, and
-   where the set of patches touching the chain's vertices grows along an edge;
-5. corners are split per incident edge, so the remaining edge graph falls apart into simple
-   paths and cycles (scipy connected components); each is ordered by one depth-first walk.
+An **arc** is a maximal chain of arc edges between corners. Corners are numbered in (x, y, z)
+order; an arc runs from its lower-numbered corner to its higher one (a loop through one corner
+starts along its edge whose other vertex is lower), and arcs are listed by (start, end, second
+point). So the same geometry gives the same corners and arcs whatever the vertex numbering:
+reading a Model3d, rebuilding its blocks from the bare surfaces and reading it back after
+writing all agree.
 
-Arc ``patches`` are sorted in right-hand order around the arc's first edge (see
-:func:`geobrep.geometry.sort_around_axis`), as :class:`~geobrep.topology.Arc` asks.
+The computation is vectorised: edge–triangle incidence, multiset signatures per arc edge (one
+``np.unique`` over a padded table), corner tests per vertex, and one depth-first walk over the
+graph of arc edges continuing each other (scipy) that lists every chain in order.
 
 >>> import geobrep
 >>> scene = geobrep.datasets.faulted_layer_cake()
@@ -32,6 +39,7 @@ Arc ``patches`` are sorted in right-hand order around the arc's first edge (see
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -43,15 +51,313 @@ from geobrep.geometry.bbox import column_extremes
 from geobrep.scene import Scene
 from geobrep.topology import Arc, Corner, Patch, Topology
 
-__all__ = ["DEFAULT_RELATIVE_TOLERANCE", "build_corners_and_arcs", "corners_and_arcs"]
+__all__ = [
+    "DEFAULT_RELATIVE_TOLERANCE",
+    "ArcChains",
+    "build_corners_and_arcs",
+    "chain_arc_edges",
+    "corners_and_arcs",
+]
 
 #: Default joining distance, relative to the diagonal of the patches' bounding box.
 DEFAULT_RELATIVE_TOLERANCE = 1e-8
 
 IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
 
 _HASH_A = np.uint64(0x9E3779B97F4A7C15)
 _HASH_B = np.uint64(0xC2B2AE3D27D4EB4F)
+
+
+@dataclass(frozen=True)
+class ArcChains:
+    """Arcs as ordered edge and vertex chains (CSR by arc).
+
+    Arc ``a`` runs along edges ``edge_ids[arc_offsets[a]:arc_offsets[a + 1]]``, each traversed
+    from ``edge_start`` to ``edge_end``, through vertices
+    ``chain_vertices[chain_offsets[a]:chain_offsets[a + 1]]``. ``corners`` are vertex ids and
+    ``arc_start`` / ``arc_end`` index into them.
+    """
+
+    edge_ids: IntArray
+    edge_start: IntArray
+    edge_end: IntArray
+    arc_offsets: IntArray
+    chain_vertices: IntArray
+    chain_offsets: IntArray
+    corners: IntArray
+    arc_start: IntArray
+    arc_end: IntArray
+
+    @property
+    def n_arcs(self) -> int:
+        return int(self.arc_offsets.shape[0] - 1)
+
+    @property
+    def edge_arc(self) -> IntArray:
+        """Arc of each ordered edge."""
+        return np.repeat(np.arange(self.n_arcs, dtype=np.int64), np.diff(self.arc_offsets)).astype(
+            np.int64
+        )
+
+
+def _segments(offsets: IntArray, rows: IntArray) -> tuple[IntArray, IntArray]:
+    """Flat positions of the CSR rows ``rows`` and the row (index into ``rows``) of each."""
+    starts = offsets[rows]
+    counts = offsets[rows + 1] - starts
+    owner = np.repeat(np.arange(rows.shape[0], dtype=np.int64), counts)
+    within = np.arange(owner.shape[0], dtype=np.int64) - np.repeat(
+        np.cumsum(counts) - counts, counts
+    )
+    return np.repeat(starts, counts) + within, owner
+
+
+def _multiset_signatures(
+    offsets: IntArray, incident_patch: IntArray, arc_edges: IntArray
+) -> IntArray:
+    """An id per arc edge, equal for edges used by the same multiset of patches."""
+    positions, rows = _segments(offsets, arc_edges)
+    counts = np.bincount(rows, minlength=arc_edges.shape[0])
+    within = np.arange(rows.shape[0], dtype=np.int64) - np.repeat(
+        np.cumsum(counts) - counts, counts
+    )
+    patches = incident_patch[positions]
+    order = np.lexsort((patches, rows))
+    table = np.full((arc_edges.shape[0], int(counts.max())), -1, dtype=np.int64)
+    table[rows, within] = patches[order]
+    _, signature = np.unique(table, axis=0, return_inverse=True)
+    return signature.reshape(-1).astype(np.int64)
+
+
+def _touch_corners(
+    edges: IntArray,
+    offsets: IntArray,
+    incident_patch: IntArray,
+    ends: IntArray,
+    n_vertices: int,
+    corner: BoolArray,
+) -> None:
+    """Rule 3: mark where the set of patches touching a chain changes (``corner`` in place)."""
+    on_arc = np.zeros(n_vertices, dtype=np.bool_)
+    on_arc[ends.reshape(-1)] = True
+    near = np.flatnonzero(on_arc[edges[:, 0]] | on_arc[edges[:, 1]])
+    positions, rows = _segments(offsets, near)
+    patch = incident_patch[positions]
+    n_patches = int(incident_patch.max()) + 1 if incident_patch.size else 1
+    keys = []
+    for column in (0, 1):
+        vertex = edges[near[rows], column]
+        keep = on_arc[vertex]
+        keys.append(vertex[keep] * n_patches + patch[keep])
+    pairs = np.unique(np.concatenate(keys))
+    vertex, member = pairs // n_patches, pairs % n_patches
+    with np.errstate(over="ignore"):
+        key = member.astype(np.uint64) + np.uint64(1)
+        h1 = np.zeros(n_vertices, dtype=np.uint64)
+        h2 = np.zeros(n_vertices, dtype=np.uint64)
+        np.add.at(h1, vertex, (key * _HASH_A) ^ (key >> np.uint64(7)))
+        np.add.at(h2, vertex, (key * _HASH_B) ^ (key << np.uint64(13)))
+    count = np.bincount(vertex, minlength=n_vertices)
+    p, q = ends[:, 0], ends[:, 1]
+    differ = (h1[p] != h1[q]) | (h2[p] != h2[q]) | (count[p] != count[q])
+    corner[p[differ & (count[p] >= count[q])]] = True
+    corner[q[differ & (count[q] >= count[p])]] = True
+
+
+def _through_pairs(
+    ends: IntArray, signature: IntArray, n_vertices: int, corner: BoolArray
+) -> tuple[IntArray, IntArray]:
+    """Pairs of arc edges (local ids) continuing each other through a non-corner vertex.
+
+    ``corner`` (per vertex) is updated in place by rules 1 and 2.
+    """
+    n = ends.shape[0]
+    flat = ends.T.reshape(-1)
+    owner = np.tile(np.arange(n, dtype=np.int64), 2)
+    order = np.argsort(flat, kind="stable")
+    vertex, edge = flat[order], owner[order]
+    degree = np.bincount(flat, minlength=n_vertices)
+    corner[flat] |= degree[flat] != 2
+    head = np.flatnonzero(
+        (vertex[:-1] == vertex[1:]) & (degree[vertex[:-1]] == 2) & ~corner[vertex[:-1]]
+    )
+    a, b, at = edge[head], edge[head + 1], vertex[head]
+    differs = signature[a] != signature[b]
+    corner[at[differs]] = True
+    keep = ~differs & ~corner[at]
+    return a[keep], b[keep]
+
+
+def _vertex_rank(points: NDArray[np.float64] | None, used: IntArray, n_vertices: int) -> IntArray:
+    """Rank of every vertex of ``used`` in (x, y, z) order (vertex id without points)."""
+    rank = np.full(n_vertices, -1, dtype=np.int64)
+    if points is None:
+        rank[used] = used
+        return rank
+    p = points[used]
+    order = np.lexsort((used, p[:, 2], p[:, 1], p[:, 0]))
+    rank[used[order]] = np.arange(used.shape[0], dtype=np.int64)
+    return rank
+
+
+def _permute_rows(offsets: IntArray, perm: IntArray) -> tuple[IntArray, IntArray]:
+    """New offsets and gather positions of CSR rows listed in ``perm`` order."""
+    lengths = np.diff(offsets)[perm]
+    new_offsets = np.zeros(perm.shape[0] + 1, dtype=np.int64)
+    np.cumsum(lengths, out=new_offsets[1:])
+    gather = np.repeat(offsets[:-1][perm] - new_offsets[:-1], lengths) + np.arange(
+        int(new_offsets[-1]), dtype=np.int64
+    )
+    return new_offsets, gather
+
+
+def _empty_chains() -> ArcChains:
+    empty = np.zeros(0, dtype=np.int64)
+    one = np.zeros(1, dtype=np.int64)
+    return ArcChains(empty, empty, empty, one, empty, one, empty, empty, empty)
+
+
+def chain_arc_edges(
+    edges: IntArray,
+    offsets: IntArray,
+    incident_patch: IntArray,
+    arc_edges: IntArray,
+    n_vertices: int,
+    points: NDArray[np.float64] | None = None,
+    extra_corners: BoolArray | None = None,
+) -> ArcChains:
+    """Corners and ordered arcs of the arc edges ``arc_edges`` (indices into ``edges``).
+
+    ``edges`` (E, 2) are all edges of the mesh with their triangles' patches in CSR form
+    (``incident_patch[offsets[e]:offsets[e + 1]]``); ``points`` (V, 3) give the geometric
+    order of corners and arcs (vertex ids without them); ``extra_corners`` (V,) are rule-4
+    corners. The rule is the module's.
+
+    >>> import numpy as np
+    >>> from geobrep.geometry import mesh
+    >>> square = np.array([[0, 1, 2], [0, 2, 3]])
+    >>> edges, offsets, faces, _ = mesh.edge_face_incidence(square)
+    >>> arc_edges = np.flatnonzero(np.diff(offsets) == 1)
+    >>> patch = np.zeros(offsets[-1], np.int64)  # both triangles in patch 0
+    >>> chains = chain_arc_edges(edges, offsets, patch, arc_edges, 4)
+    >>> chains.n_arcs, chains.corners.tolist()  # one closed border, cornered at vertex 0
+    (1, [0])
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components, depth_first_order
+
+    arc_edges = np.asarray(arc_edges, dtype=np.int64)
+    n = int(arc_edges.shape[0])
+    if n == 0:
+        return _empty_chains()
+    ends = edges[arc_edges]
+    signature = _multiset_signatures(offsets, incident_patch, arc_edges)
+    corner = np.zeros(n_vertices, dtype=np.bool_)
+    _touch_corners(edges, offsets, incident_patch, ends, n_vertices, corner)
+    if extra_corners is not None:
+        corner |= extra_corners
+    degree = np.bincount(ends.reshape(-1), minlength=n_vertices)
+    corner &= degree > 0
+    a, b = _through_pairs(ends, signature, n_vertices, corner)
+    rank = _vertex_rank(points, np.flatnonzero(degree > 0), n_vertices)
+
+    def components(a: IntArray, b: IntArray) -> IntArray:
+        graph = coo_matrix((np.ones(a.shape[0], np.int8), (a, b)), shape=(n, n))
+        labels: IntArray = connected_components(graph, directed=False)[1].astype(np.int64)
+        return labels
+
+    component = components(a, b)
+    # Rule 5: closed chains with no corner get their lowest vertex as one.
+    n_components = int(component.max()) + 1
+    touches = (corner[ends[:, 0]] | corner[ends[:, 1]]).astype(np.float64)
+    closed = np.flatnonzero(np.bincount(component, weights=touches, minlength=n_components) == 0)
+    if closed.size:
+        lowest = np.full(n_components, np.iinfo(np.int64).max, dtype=np.int64)
+        np.minimum.at(lowest, component, np.minimum(rank[ends[:, 0]], rank[ends[:, 1]]))
+        by_rank = np.empty(int(rank.max()) + 1, dtype=np.int64)
+        by_rank[rank[rank >= 0]] = np.flatnonzero(rank >= 0)
+        corner[by_rank[lowest[closed]]] = True
+        a, b = _through_pairs(ends, signature, n_vertices, corner)
+        component = components(a, b)
+        n_components = int(component.max()) + 1
+
+    # Head of each chain: its edge at its lowest corner (ties: the lower other vertex).
+    candidate_edge = np.tile(np.arange(n, dtype=np.int64), 2)
+    candidate_vertex = ends.T.reshape(-1)
+    at_corner = corner[candidate_vertex]
+    candidate_edge, candidate_vertex = candidate_edge[at_corner], candidate_vertex[at_corner]
+    other = ends[candidate_edge].sum(axis=1) - candidate_vertex
+    candidate_component = component[candidate_edge]
+    order = np.lexsort((rank[other], rank[candidate_vertex], candidate_component))
+    first = np.ones(order.shape[0], dtype=np.bool_)
+    first[1:] = candidate_component[order][1:] != candidate_component[order][:-1]
+    heads = candidate_edge[order][first]
+    head_vertex = candidate_vertex[order][first]
+
+    # A depth-first walk from a virtual root tied to every head lists each chain in order.
+    root = n
+    rows = np.concatenate([a, np.full(heads.shape[0], root, dtype=np.int64)])
+    cols = np.concatenate([b, heads])
+    graph = coo_matrix((np.ones(rows.shape[0], np.int8), (rows, cols)), shape=(n + 1, n + 1))
+    walk = depth_first_order(graph.tocsr(), root, directed=False, return_predecessors=False)
+    ordered = np.asarray(walk[1:], dtype=np.int64)
+    if ordered.shape[0] != n:  # pragma: no cover - every chain has a head
+        raise TopologyError("arc reconstruction failed: a chain does not end at a corner")
+    chain_of = component[ordered]
+    new_chain = np.ones(n, dtype=np.bool_)
+    new_chain[1:] = chain_of[1:] != chain_of[:-1]
+    arc = np.cumsum(new_chain) - 1
+    arc_offsets = np.append(np.flatnonzero(new_chain), n).astype(np.int64)
+    head_of_component = np.empty(n_components, dtype=np.int64)
+    head_of_component[component[heads]] = head_vertex
+
+    # Direction of every edge along its arc.
+    p, q = ends[ordered, 0], ends[ordered, 1]
+    start = np.empty(n, dtype=np.int64)
+    end = np.empty(n, dtype=np.int64)
+    has_next = np.zeros(n, dtype=np.bool_)
+    has_next[:-1] = arc[1:] == arc[:-1]
+    k = np.flatnonzero(has_next)
+    p_shared = (p[k] == p[k + 1]) | (p[k] == q[k + 1])
+    end[k] = np.where(p_shared, p[k], q[k])
+    start[k] = np.where(p_shared, q[k], p[k])
+    last = np.flatnonzero(~has_next)
+    single = arc_offsets[arc[last]] == last
+    previous_end = end[np.maximum(last - 1, 0)]
+    start[last] = np.where(single, head_of_component[chain_of[last]], previous_end)
+    end[last] = p[last] + q[last] - start[last]
+
+    n_arcs = arc_offsets.shape[0] - 1
+    chain_offsets = arc_offsets + np.arange(n_arcs + 1, dtype=np.int64)
+    chain = np.empty(n + n_arcs, dtype=np.int64)
+    chain[np.arange(n) + arc] = start
+    chain[last + arc[last] + 1] = end[last]
+
+    corner_vertices = np.flatnonzero(corner)
+    corners = corner_vertices[np.argsort(rank[corner_vertices], kind="stable")].astype(np.int64)
+    corner_index = np.full(n_vertices, -1, dtype=np.int64)
+    corner_index[corners] = np.arange(corners.shape[0], dtype=np.int64)
+    arc_start = corner_index[start[arc_offsets[:-1]]]
+    arc_end = corner_index[end[last]]
+    if (arc_start < 0).any() or (arc_end < 0).any():  # pragma: no cover - heads are corners
+        raise TopologyError("arc reconstruction failed: a chain does not end at a corner")
+
+    # Arcs listed by (start corner, end corner, rank of the second point).
+    second = rank[chain[chain_offsets[:-1] + 1]]
+    perm = np.lexsort((second, arc_end, arc_start)).astype(np.int64)
+    arc_offsets, edge_gather = _permute_rows(arc_offsets, perm)
+    chain_offsets, chain_gather = _permute_rows(chain_offsets, perm)
+    return ArcChains(
+        edge_ids=arc_edges[ordered][edge_gather],
+        edge_start=start[edge_gather],
+        edge_end=end[edge_gather],
+        arc_offsets=arc_offsets,
+        chain_vertices=chain[chain_gather],
+        chain_offsets=chain_offsets,
+        corners=corners,
+        arc_start=arc_start[perm],
+        arc_end=arc_end[perm],
+    )
 
 
 def build_corners_and_arcs(
@@ -129,7 +435,9 @@ def corners_and_arcs(
     """Corners, arcs and ``{patch id: arc ids}`` of ``patches`` (surfaces by entity id).
 
     The lower-level form of :func:`build_corners_and_arcs`, for readers that assemble a
-    topology before they have a scene.
+    topology before they have a scene. Arc ``patches`` list the patch of every triangle at the
+    arc's first edge (a patch on both sides twice) in right-hand order about that edge (see
+    :func:`geobrep.geometry.sort_around_axis`), as :class:`~geobrep.topology.Arc` asks.
     """
     vertices, triangles, owners = _patch_triangles(surfaces, patches)
     if triangles.shape[0] == 0:
@@ -144,169 +452,56 @@ def corners_and_arcs(
     tri = inverse[compact.reshape(-1, 3)]
     proper = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
     tri, owners = tri[proper], owners[proper]
+    if tri.shape[0] == 0:
+        return [], [], {}
     n_vertices = merged.shape[0]
 
-    # -- boundary half-edges of every patch -------------------------------------------------
-    start = tri.reshape(-1)
-    end = tri[:, [1, 2, 0]].reshape(-1)
-    third = tri[:, [2, 0, 1]].reshape(-1)
-    owner = np.repeat(owners, 3)
-    lo, hi = np.minimum(start, end), np.maximum(start, end)
-    _, record, counts = np.unique(
-        np.stack([owner, lo, hi], axis=1), axis=0, return_inverse=True, return_counts=True
-    )
-    boundary = counts[record.reshape(-1)] == 1
-    lo, hi, third, owner = lo[boundary], hi[boundary], third[boundary], owner[boundary]
-    if lo.size == 0:
-        return [], [], {}
-
-    # -- unique edges and the signature of their patch sets ---------------------------------
-    edges, edge_of = np.unique(np.stack([lo, hi], axis=1), axis=0, return_inverse=True)
-    edge_of = edge_of.reshape(-1)
-    n_edges = edges.shape[0]
-    with np.errstate(over="ignore"):
-        key = owner.astype(np.uint64) + np.uint64(1)
-        h1 = np.zeros(n_edges, dtype=np.uint64)
-        h2 = np.zeros(n_edges, dtype=np.uint64)
-        np.add.at(h1, edge_of, (key * _HASH_A) ^ (key >> np.uint64(7)))
-        np.add.at(h2, edge_of, (key * _HASH_B) ^ (key << np.uint64(13)))
-    multiplicity = np.bincount(edge_of, minlength=n_edges)
-    # The same signature for the set of patches touching each vertex at all.
-    touching = np.unique(np.stack([tri.reshape(-1), np.repeat(owners, 3)], axis=1), axis=0)
-    with np.errstate(over="ignore"):
-        touch_key = touching[:, 1].astype(np.uint64) + np.uint64(1)
-        v1 = np.zeros(n_vertices, dtype=np.uint64)
-        v2 = np.zeros(n_vertices, dtype=np.uint64)
-        np.add.at(v1, touching[:, 0], (touch_key * _HASH_A) ^ (touch_key >> np.uint64(7)))
-        np.add.at(v2, touching[:, 0], (touch_key * _HASH_B) ^ (touch_key << np.uint64(13)))
-    touch_count = np.bincount(touching[:, 0], minlength=n_vertices)
-    _, signature = np.unique(
-        np.stack([h1.view(np.int64), h2.view(np.int64), multiplicity], axis=1),
-        axis=0,
-        return_inverse=True,
-    )
-    signature = signature.reshape(-1).astype(np.int64)
-
-    # -- corners ------------------------------------------------------------------------------
-    ends = edges.reshape(-1)
-    edge_signature = np.repeat(signature, 2)
-    degree = np.bincount(ends, minlength=n_vertices)
-    sig_min = np.full(n_vertices, np.iinfo(np.int64).max, dtype=np.int64)
-    sig_max = np.full(n_vertices, -1, dtype=np.int64)
-    np.minimum.at(sig_min, ends, edge_signature)
-    np.maximum.at(sig_max, ends, edge_signature)
-    is_corner = (degree > 0) & ((degree != 2) | (sig_min != sig_max))
-    # Where the set of patches touching the chain grows (a free fault border meeting a
-    # horizon, or starting to run along a boundary it is not conformal with), the vertex that
-    # touches more patches than its chain neighbour is a corner.
-    lo_end, hi_end = edges[:, 0], edges[:, 1]
-    differ = (
-        (v1[lo_end] != v1[hi_end])
-        | (v2[lo_end] != v2[hi_end])
-        | (touch_count[lo_end] != touch_count[hi_end])
-    )
-    is_corner[lo_end[differ & (touch_count[lo_end] >= touch_count[hi_end])]] = True
-    is_corner[hi_end[differ & (touch_count[hi_end] >= touch_count[lo_end])]] = True
+    edges, offsets, incident, sides = mesh.edge_face_incidence(tri)
+    incident_patch = owners[incident]
+    counts = np.diff(offsets)
+    inner = counts == 2
+    pair = np.flatnonzero(inner)
+    inner[pair] = incident_patch[offsets[pair]] == incident_patch[offsets[pair] + 1]
+    hints = None
     if extra_corners is not None:
-        hints = np.asarray(extra_corners, dtype=np.float64).reshape(-1, 3)
-        if hints.shape[0]:
+        wanted = np.asarray(extra_corners, dtype=np.float64).reshape(-1, 3)
+        if wanted.shape[0]:
             from scipy.spatial import cKDTree
 
             centre = 0.5 * np.add(*column_extremes(merged))
-            distance, nearest = cKDTree(merged - centre).query(hints - centre)
-            hit = nearest[distance <= max(tolerance, 0.0) * 1.0000001 + 0.0]
-            is_corner[hit[degree[hit] > 0]] = True
+            distance, nearest = cKDTree(merged - centre).query(wanted - centre)
+            hints = np.zeros(n_vertices, dtype=np.bool_)
+            hints[nearest[distance <= max(tolerance, 0.0) * 1.0000001]] = True
+    chains = chain_arc_edges(
+        edges, offsets, incident_patch, np.flatnonzero(~inner), n_vertices, merged, hints
+    )
 
-    # -- split corners per incident edge; components are paths or cycles ---------------------
-    node = edges.copy()
-    corner_end = is_corner[edges]
-    node[corner_end] = n_vertices + np.flatnonzero(corner_end.reshape(-1))
-    n_nodes = n_vertices + 2 * n_edges
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components, depth_first_order
-
-    graph = coo_matrix(
-        (np.ones(n_edges, dtype=np.int8), (node[:, 0], node[:, 1])), shape=(n_nodes, n_nodes)
-    ).tocsr()
-    graph = (graph + graph.T).tocsr()
-    _, component = connected_components(graph, directed=False)
-    edge_component = component[node[:, 0]]
-    _, arc_of_edge = np.unique(edge_component, return_inverse=True)
-    arc_of_edge = arc_of_edge.reshape(-1)
-    n_arcs = int(arc_of_edge.max()) + 1
-    node_vertex = np.concatenate([np.arange(n_vertices), ends])
-
-    # Start nodes: a split corner node of the arc (paths), or the lowest vertex (cycles).
-    corner_nodes = node[corner_end]
-    corner_arc = np.repeat(arc_of_edge, 2)[corner_end.reshape(-1)]
-    start_node = np.full(n_arcs, -1, dtype=np.int64)
-    lowest = np.full(n_arcs, np.iinfo(np.int64).max, dtype=np.int64)
-    np.minimum.at(lowest, corner_arc, node_vertex[corner_nodes])
-    has_corner = lowest < np.iinfo(np.int64).max
-    # among corner nodes of an arc, start at the one on the lowest corner vertex
-    candidate = corner_nodes[node_vertex[corner_nodes] == lowest[corner_arc]]
-    candidate_arc = corner_arc[node_vertex[corner_nodes] == lowest[corner_arc]]
-    start_node[candidate_arc[::-1]] = candidate[::-1]
-    cycles = np.flatnonzero(~has_corner)
-    if cycles.size:
-        low_vertex = np.full(n_arcs, np.iinfo(np.int64).max, dtype=np.int64)
-        np.minimum.at(low_vertex, arc_of_edge, edges.min(axis=1))
-        start_node[cycles] = low_vertex[cycles]
-        is_corner[low_vertex[cycles]] = True
-
-    corner_vertices = np.flatnonzero(is_corner & (degree > 0))
-    corner_id = np.full(n_vertices, -1, dtype=np.int64)
-    corner_id[corner_vertices] = np.arange(corner_vertices.shape[0])
-    corners = [Corner(id=int(i), point=merged[v]) for i, v in enumerate(corner_vertices.tolist())]
-
-    chains: list[IntArray] = []
-    for arc in range(n_arcs):
-        walk = depth_first_order(
-            graph, int(start_node[arc]), directed=False, return_predecessors=False
-        )
-        sequence = node_vertex[walk]
-        if not has_corner[arc]:
-            sequence = np.append(sequence, sequence[0])
-        elif not is_corner[sequence[-1]]:
-            raise TopologyError("arc reconstruction failed: a chain does not end at a corner")
-        chains.append(sequence.astype(np.int64))
-    # Direction: from the lower corner id to the higher (ties: lower second vertex first).
-    keyed: list[tuple[int, int, int, IntArray, int]] = []
-    for arc, sequence in enumerate(chains):
-        first, last = int(corner_id[sequence[0]]), int(corner_id[sequence[-1]])
-        if first > last or (first == last and sequence.shape[0] > 2 and sequence[-2] < sequence[1]):
-            sequence = sequence[::-1].copy()
-            first, last = last, first
-        keyed.append((first, last, int(sequence[1]), sequence, arc))
-    keyed.sort(key=lambda item: (item[0], item[1], item[2]))
-
-    # Patches around each arc, right-hand order about its first edge.
-    record_edge = edge_of
-    record_order = np.argsort(record_edge, kind="stable")
-    record_start = np.searchsorted(record_edge[record_order], np.arange(n_edges + 1))
-    edge_keys = edges[:, 0] * n_vertices + edges[:, 1]
+    corners = [Corner(id=i, point=merged[v]) for i, v in enumerate(chains.corners.tolist())]
     arcs: list[Arc] = []
     patch_arcs: dict[int, list[int]] = {}
-    for new_id, (start, end, _, sequence, _) in enumerate(keyed):
-        p0, p1 = int(sequence[0]), int(sequence[1])
-        edge = int(np.searchsorted(edge_keys, min(p0, p1) * n_vertices + max(p0, p1)))
-        records = record_order[record_start[edge] : record_start[edge + 1]]
-        members = owner[records]
-        origin = merged[p0]
-        directions = merged[third[records]] - origin
+    for a in range(chains.n_arcs):
+        first = int(chains.arc_offsets[a])
+        edge = int(chains.edge_ids[first])
+        p0, p1 = int(chains.edge_start[first]), int(chains.edge_end[first])
+        around = slice(int(offsets[edge]), int(offsets[edge + 1]))
+        members = incident_patch[around]
+        thirds = tri[incident[around], (sides[around] + 2) % 3]
         if members.shape[0] > 1:
-            around = mesh.sort_around_axis(origin, merged[p1] - origin, directions)
-            members = members[around]
+            origin = merged[p0]
+            members = members[
+                mesh.sort_around_axis(origin, merged[p1] - origin, merged[thirds] - origin)
+            ]
         patch_ids = tuple(int(patches[int(m)].id) for m in members.tolist())
+        chain = chains.chain_vertices[chains.chain_offsets[a] : chains.chain_offsets[a + 1]]
         arcs.append(
             Arc(
-                id=new_id,
-                points=merged[sequence],
-                start=start,
-                end=end,
+                id=a,
+                points=merged[chain],
+                start=int(chains.arc_start[a]),
+                end=int(chains.arc_end[a]),
                 patches=patch_ids,
             )
         )
         for patch_id in dict.fromkeys(patch_ids):
-            patch_arcs.setdefault(patch_id, []).append(new_id)
+            patch_arcs.setdefault(patch_id, []).append(a)
     return corners, arcs, patch_arcs

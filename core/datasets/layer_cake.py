@@ -6,9 +6,10 @@ subdivided once and extruded along y, and every section cell becomes the south (
 (y = length) faces of a block, so surfaces meeting along a line share those vertices exactly.
 A volume-preserving fold ``z += A sin(πx/X) sin(πy/Y)`` then bends horizons, fault and top while
 the walls stay planar. Because the construction knows every patch and block, the scene carries
-its complete topology: patches with their positive/negative blocks, arcs with their patches in
-right-hand order, corners, and the blocks with their signed patch lists — a ground truth for the
-block builder and a test bed for clipping and voxelization.
+its patches with their positive/negative blocks and the blocks with their signed patch lists;
+corners and arcs (patches in right-hand order) follow geobrep's one rule (:mod:`geobrep.arcs`),
+the rule of the GOCAD reader and the block builder — a ground truth for the block builder and a
+test bed for clipping and voxelization.
 """
 
 from __future__ import annotations
@@ -21,11 +22,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.arcs import corners_and_arcs
 from geobrep.crs import CRS
 from geobrep.entities import UNIVERSE_KIND, Block, PatchSide, Surface
 from geobrep.geometry import mesh
 from geobrep.scene import Group, Scene
-from geobrep.topology import Arc, Corner, Patch, Topology
+from geobrep.topology import Patch, Topology
 
 __all__ = ["faulted_layer_cake"]
 
@@ -262,9 +264,6 @@ def faulted_layer_cake(
         section,
         cells,
         patch_of_edge,
-        edge_points,
-        ys,
-        fold,
         origin,
         n_horizons,
         cell_names,
@@ -276,15 +275,10 @@ def _with_topology(
     section: _Section,
     cells: list[list[tuple[int, int]]],
     patch_of_edge: dict[int, tuple[int, int]],
-    edge_points: list[NDArray[np.float64]],
-    ys: NDArray[np.float64],
-    fold: object,
     origin: tuple[float, float, float],
     n_horizons: int,
     cell_names: list[tuple[str, int]],
 ) -> Scene:
-    assert callable(fold)
-    pts = np.asarray(section.points)
     by_name = {s.name: s for s in surfaces}
     next_id = len(surfaces)
     # Blocks: one per cell, named by side of the fault and layer; then the universe.
@@ -316,63 +310,6 @@ def _with_topology(
         for cell in range(len(cells)):
             assign(patch_ids[(int(by_name[face_name].id or 0), cell)], 1, universe_id)
 
-    # Corners at both ends of every section vertex's y-line; arcs along y and along edges.
-    n_points = len(section.points)
-    corners = [
-        Corner(id=k * n_points + v, point=fold(np.array([[pts[v][0], y, pts[v][1]]]))[0])
-        for k, y in enumerate((ys[0], ys[-1]))
-        for v in range(n_points)
-    ]
-    arcs: list[Arc] = []
-    patch_arcs: dict[int, list[int]] = defaultdict(list)
-
-    def add_arc(
-        points: NDArray[np.float64],
-        start: int,
-        end: int,
-        members: list[tuple[int, NDArray[np.float64]]],
-    ) -> None:
-        axis = points[-1] - points[0]
-        order = mesh.sort_around_axis(points[0], axis, np.array([d for _, d in members]))
-        arc_id = len(arcs)
-        arcs.append(
-            Arc(
-                id=arc_id,
-                points=fold(points),
-                start=start,
-                end=end,
-                patches=tuple(members[i][0] for i in order),
-            )
-        )
-        for patch, _ in members:
-            patch_arcs[patch].append(arc_id)
-
-    for v in range(n_points):
-        members = []
-        for edge, (_, a, b) in enumerate(section.edges):
-            if v in (a, b):
-                other = b if v == a else a
-                direction = pts[other] - pts[v]
-                members.append(
-                    (patch_ids[patch_of_edge[edge]], np.array([direction[0], 0.0, direction[1]]))
-                )
-        line = np.column_stack([np.full(len(ys), pts[v][0]), ys, np.full(len(ys), pts[v][1])])
-        add_arc(line, v, n_points + v, members)
-    for edge, (_, a, b) in enumerate(section.edges):
-        dx, dz = pts[b] - pts[a]
-        left = np.array([-dz, 0.0, dx])
-        for k, (y, face_name, inward) in enumerate(
-            ((ys[0], "south", 1.0), (ys[-1], "north", -1.0))
-        ):
-            members = [(patch_ids[patch_of_edge[edge]], np.array([0.0, inward, 0.0]))]
-            for cell, direction in edge_cells[edge]:
-                members.append(
-                    (patch_ids[(int(by_name[face_name].id or 0), cell)], left * direction)
-                )
-            line = edge_points[edge]
-            points = np.column_stack([line[:, 0], np.full(len(line), y), line[:, 1]])
-            add_arc(points, k * n_points + a, k * n_points + b, members)
-
     patches = [
         Patch(
             id=pid,
@@ -381,10 +318,12 @@ def _with_topology(
             name=by_name_label(surfaces, sid, label),
             positive_block=positive.get(pid),
             negative_block=negative.get(pid),
-            arcs=tuple(patch_arcs[pid]),
         )
         for (sid, label), pid in patch_ids.items()
     ]
+    # Corners and arcs by geobrep's one rule (geobrep.arcs), as readers and the builder find them.
+    corners, arcs, patch_arcs = corners_and_arcs({int(s.id or 0): s for s in surfaces}, patches)
+    patches = [p.model_copy(update={"arcs": tuple(patch_arcs.get(p.id, ()))}) for p in patches]
     blocks = [
         Block(
             id=block_id,

@@ -130,7 +130,7 @@ def build_blocks(scene: Scene, options: BlockBuilderOptions) -> Scene:
         with watch.stage("patches"):
             split = split_patches(soup)
         with watch.stage("arcs"):
-            chains = chain_arcs(split, soup.vertices.shape[0])
+            chains = chain_arcs(split, soup.vertices.shape[0], soup.vertices)
         if passes == 1 and free_border_arcs(split, chains).size:
             open_border = str(_free_border_error(soup, split, chains))
         if passes == 1 and options.check_conformity:
