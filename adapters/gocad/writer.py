@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 from geobrep.adapters.gocad.headers import quote_rest
 from geobrep.adapters.gocad.numbers import format_float, format_rows, row_pieces
 from geobrep.adapters.gocad.objects import (
+    _TYPE_OF_KIND,
     CTETRA_PROPERTY,
     FLAG_PROPERTY,
     ObjectText,
@@ -34,8 +35,10 @@ from geobrep.adapters.gocad.objects import (
     z_sign_of,
 )
 from geobrep.adapters.gocad.options import GocadOptions
+from geobrep.arcs import DEFAULT_RELATIVE_TOLERANCE
 from geobrep.entities import Block, Entity, PointSet, PolyLine, Surface, TetMesh
 from geobrep.errors import FormatError
+from geobrep.geometry.bbox import column_extremes
 from geobrep.scene import Group, Scene
 
 __all__ = ["OBJECT_TYPES", "write_gocad"]
@@ -51,6 +54,8 @@ OBJECT_TYPES = {
 }
 _ENTITY_OF = {"TSurf": Surface, "PLine": PolyLine, "VSet": PointSet, "TSolid": TetMesh}
 _GROUP_KINDS = ("HeterogeneousGroup", "HomogeneousGroup")
+#: TSurf HEADER key holding the geobrep ``kind`` when no GOCAD type says it (``cap``, ...).
+KIND_KEY = "geobrep_kind"
 
 
 def _version(entity: Entity | None) -> str:
@@ -73,8 +78,12 @@ class _Writer:
         cell_prefix: str,
         extra_header: tuple[tuple[str, str], ...] = (),
     ) -> tuple[list[Any], list[Any], float]:
-        in_model = bool(extra_header)  # a Model3d member: its TFACE lines carry the type
+        in_model = object_type == "TSurf" and any(
+            k == "name_in_model_list" for k, _ in extra_header
+        )  # a Model3d member: its TFACE lines carry the type
         meta = gocad_metadata(entity)
+        if any(k == KIND_KEY for k, _ in meta.get("header", [])):
+            meta = {**meta, "header": [kv for kv in meta["header"] if kv[0] != KIND_KEY]}
         out.add(f"GOCAD {object_type} {_version(entity)}")
         out.add(
             *header_lines(
@@ -108,10 +117,16 @@ class _Writer:
         out.add("END")
 
     # -- TSurf ----------------------------------------------------------------------------------
-    def tsurf(self, surface: Surface, extra_header: tuple[tuple[str, str], ...] = ()) -> bytes:
+    def tsurf(
+        self,
+        surface: Surface,
+        extra_header: tuple[tuple[str, str], ...] = (),
+        tface_type: str | None = None,
+    ) -> bytes:
         out = ObjectText()
         if surface.faces.shape[1] == 4:
             report(f"{surface.label}: quads are written as two triangles each")
+        extra_header = (*extra_header, *_kind_header(surface, tface_type))
         chosen, cell_chosen, z_sign = self.head(
             out,
             "TSurf",
@@ -131,14 +146,16 @@ class _Writer:
             report(f"{surface.label}: faces are reordered to group them by patch (TFACE)")
             order = np.argsort(labels, kind="stable")
             faces, labels, source = faces[order], labels[order], source[order]
-        n_parts = surface.n_patches
+        present = _written_labels(surface)  # a patch without triangles is no TFACE
+        labels = np.searchsorted(present, labels)
+        n_parts = int(present.shape[0])
         starts = part_vertex_ranges(surface.n_vertices, faces, labels, n_parts)
         vw = self.vertex_writer(surface, chosen, z_sign)
         cell_values = value_columns(cell_chosen, surface.n_faces)[source] if cell_chosen else None
         bounds = np.searchsorted(labels, np.arange(n_parts + 1))
         for part in range(n_parts):
-            name = surface.patch_name(part)
-            out.add("TFACE" if name == str(part) else f"TFACE {name}")
+            name = surface.patch_name(int(present[part]))
+            out.add("TFACE" if name in (str(part), str(int(present[part]))) else f"TFACE {name}")
             out.add_pieces(vw.lines(int(starts[part]), int(starts[part + 1])))
             lo, hi = int(bounds[part]), int(bounds[part + 1])
             values = cell_values[lo:hi] if cell_values is not None else None
@@ -151,39 +168,40 @@ class _Writer:
         return out.text()
 
     def borders(self, out: ObjectText, surface: Surface) -> None:
+        """BSTONE / BORDER lines: the source's when they still fit the scene's corners and
+        arcs, else derived from them (a corner at every BSTONE, a BORDER along every arc)."""
         meta = gocad_metadata(surface)
         n = surface.n_vertices
         bstones = [int(v) for v in meta.get("bstones", []) if 0 <= int(v) < n]
         borders = [
             (int(a), int(b)) for a, b in meta.get("borders", []) if 0 <= a < n and 0 <= b < n
         ]
-        if not bstones and not borders and meta.get("type") != "TSurf":
-            # not read from GOCAD: BSTONE/BORDER from the scene's corners and arcs
-            bstones, borders = self._derived_borders(surface)
+        places = self._border_places(surface)
+        if places is not None and not places.fit(bstones, borders):
+            bstones, borders = places.derived()
         for v in bstones:
             out.add(f"BSTONE {v + 1}")
         for k, (a, b) in enumerate(borders):
             out.add(f"BORDER {n + k + 1} {a + 1} {b + 1}")
 
-    def _derived_borders(self, surface: Surface) -> tuple[list[int], list[tuple[int, int]]]:
-        """BSTONE/BORDER from the scene's corners and arcs touching this surface's patches."""
+    def _border_places(self, surface: Surface) -> _BorderPlaces | None:
+        """The scene's corners and arcs on this surface's patches (None: it has none)."""
         topology = self.scene.topology
         mine = {p.id for p in topology.patches if p.surface == surface.id}
-        if not mine or not topology.arcs:
-            return [], []
-        index = {tuple(row): i for i, row in enumerate(surface.vertices.tolist())}
-        bstones: list[int] = []
-        borders: list[tuple[int, int]] = []
-        for arc in topology.arcs:
-            if not mine.intersection(arc.patches):
-                continue
-            first, second = tuple(arc.points[0].tolist()), tuple(arc.points[1].tolist())
-            if first in index and second in index:
-                a = index[first]
-                if a not in bstones:
-                    bstones.append(a)
-                borders.append((a, index[second]))
-        return bstones, borders
+        if not mine or not topology.corners or surface.n_vertices == 0:
+            return None
+        arcs = [a for a in topology.arcs if mine.intersection(a.patches)]
+        return _BorderPlaces(surface, self._tolerance(), [c.point for c in topology.corners], arcs)
+
+    def _tolerance(self) -> float:
+        if not hasattr(self, "_joining"):
+            points = [s.vertices for s in self.scene.surfaces if s.n_vertices]
+            diagonal = 1.0
+            if points:
+                low, high = column_extremes(np.concatenate(points))
+                diagonal = float(np.linalg.norm(high - low)) or 1.0
+            self._joining = DEFAULT_RELATIVE_TOLERANCE * diagonal
+        return self._joining
 
     # -- PLine ----------------------------------------------------------------------------------
     def pline(self, line: PolyLine) -> bytes:
@@ -360,8 +378,12 @@ class _Writer:
         if not surfaces:
             surfaces = list(scene.surfaces)
         names = _unique_names([_model_name(s) for s in surfaces])
+        written = {int(s.id or 0): _written_labels(s).tolist() for s in surfaces}
+        for empty in topology.patches:
+            if empty.label not in written.get(empty.surface, [empty.label]):
+                report(f"patch {empty.id} has no triangle: no TFACE is written for it")
         # TFACE header entries: ordered by patch id, each surface's labels in increasing order.
-        entries = [(s, k) for s in surfaces for k in range(s.n_patches)]
+        entries = [(s, k) for s in surfaces for k in written[int(s.id or 0)]]
         big = 1 << 62
         entries.sort(
             key=lambda e: (
@@ -375,8 +397,9 @@ class _Writer:
             slots.setdefault(int(s.id or 0), []).append(position)
         ordered: list[tuple[Surface, int]] = [entries[0]] * len(entries) if entries else []
         for s in surfaces:
+            labels = written[int(s.id or 0)]
             for k, position in enumerate(slots.get(int(s.id or 0), [])):
-                ordered[position] = (s, k)
+                ordered[position] = (s, labels[k])
         tface_of: dict[int, int] = {}
         flipped: dict[int, bool] = {}
         out = ObjectText()
@@ -388,24 +411,18 @@ class _Writer:
         for name in names:
             out.add(f"TSURF {quote_rest(name)}")
         name_of = {int(s.id or 0): n for s, n in zip(surfaces, names, strict=True)}
+        tface_type: dict[int, str] = {}
         for number, (surface, label) in enumerate(ordered, start=1):
             patch = patch_of.get((int(surface.id or 0), label))
             pmeta = gocad_section(patch.metadata) if patch is not None else {}
             geo_type = pmeta.get("geological_type") or _surface_type(surface)
+            tface_type.setdefault(int(surface.id or 0), str(geo_type))
             out.add(f"TFACE {number}  {geo_type} {quote_rest(name_of[int(surface.id or 0)])}")
-            faces = surface.patch_faces(label)
+            faces = surface.patch_faces(label)  # never empty: empty patches are not written
             key = pmeta.get("key_triangle")
             if not (isinstance(key, int) and key in set(faces.tolist())):
-                key = int(faces[0]) if faces.size else None
-            if key is None:
-                report(
-                    f"{surface.label}: patch {label} has no triangle; its TFACE key triangle "
-                    "is written as three copies of one point"
-                )
-                point = surface.vertices[0] if surface.n_vertices else np.zeros(3)
-                corners = np.array([point, point, point], dtype=np.float64)
-            else:
-                corners = np.array(surface.vertices[surface.faces[key][:3]], dtype=np.float64)
+                key = int(faces[0])
+            corners = np.array(surface.vertices[surface.faces[key][:3]], dtype=np.float64)
             reverse = bool(pmeta.get("key_reversed"))
             if reverse:
                 corners = corners[::-1]
@@ -441,11 +458,10 @@ class _Writer:
         pieces = [out.text()]
         model_name = {int(s.id or 0): n for s, n in zip(surfaces, names, strict=True)}
         for surface in scene.surfaces:  # scene order; surfaces outside the model too
-            if gocad_metadata(surface).get("type") == "TSolid.SURFACE":
-                continue
+            # a TSolid's SURFACEs too: the TSolid itself is not written in a Model3d
             member = model_name.get(int(surface.id or 0))
             extra = (("name_in_model_list", member),) if member is not None else ()
-            pieces.append(self.tsurf(surface, extra))
+            pieces.append(self.tsurf(surface, extra, tface_type.get(int(surface.id or 0))))
         skipped = [e.label for e in scene.entities if not isinstance(e, Surface | Block)]
         if skipped:
             report(f"a Model3d holds surfaces and regions only; not written: {', '.join(skipped)}")
@@ -483,10 +499,17 @@ class _Writer:
             keyword = keyword_of[str(group.kind)]
             raw = gocad_section(group.metadata)
             if keyword in ("LAYER", "FAULT_BLOCK"):
+                # the REGIONs of its blocks still written; of the source's list, the ids that
+                # named no REGION there are kept, a dropped block's are not
                 ids = [region_of[m] for m in group.members if m in region_of]
                 kept = raw.get("regions")
-                if isinstance(kept, list) and [i for i in kept if i in region_of.values()] == ids:
-                    ids = kept
+                unmatched = raw.get("unmatched")
+                if isinstance(kept, list) and isinstance(unmatched, list):
+                    stay = set(ids) | set(unmatched)
+                    if [i for i in kept if i in region_of.values()] == ids:
+                        ids = [i for i in kept if i in stay]
+                elif isinstance(kept, list) and [i for i in kept if i in region_of.values()] == ids:
+                    ids = kept  # a scene from before "unmatched" was recorded
             else:
                 ids = [t for m in group.members for t in by_surface.get(m, [])]
                 kept = raw.get("tfaces")
@@ -538,6 +561,100 @@ class _Writer:
                 pieces.append(text)
         pieces.append(b"END_MEMBERS\nEND\n")
         return b"".join(pieces)
+
+
+class _BorderPlaces:
+    """Where one surface's vertices meet the scene's corners and arcs (within ``tolerance``)."""
+
+    def __init__(
+        self,
+        surface: Surface,
+        tolerance: float,
+        corner_points: list[NDArray[np.float64]],
+        arcs: list[Any],
+    ) -> None:
+        from scipy.spatial import cKDTree
+
+        self.surface = surface
+        self.arcs = arcs
+        self.tolerance = tolerance
+        vertices = np.asarray(surface.vertices, dtype=np.float64)
+        self.centre = 0.5 * np.add(*column_extremes(vertices))
+        self.tree = cKDTree(vertices - self.centre)
+        n = surface.n_vertices
+        self.is_corner = self._mask(np.asarray(corner_points).reshape(-1, 3), n)
+        arc_points = [np.asarray(a.points) for a in arcs]
+        self.on_arc = self._mask(np.concatenate(arc_points) if arc_points else np.zeros((0, 3)), n)
+        triangles, _ = _triangles(surface)
+        pairs = np.sort(triangles[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2), axis=1)
+        self.edge_keys = np.unique(pairs[:, 0] * n + pairs[:, 1])
+
+    def _near(self, points: NDArray[np.float64]) -> list[list[int]]:
+        found: list[list[int]] = self.tree.query_ball_point(
+            points - self.centre, r=self.tolerance, return_sorted=True
+        ).tolist()
+        return found
+
+    def _mask(self, points: NDArray[np.float64], n: int) -> NDArray[np.bool_]:
+        mask = np.zeros(n, dtype=np.bool_)
+        if points.shape[0]:
+            hits = [v for near in self._near(points) for v in near]
+            mask[np.asarray(hits, dtype=np.int64)] = True
+        return mask
+
+    def _is_edge(self, a: int, b: int) -> bool:
+        n = self.surface.n_vertices
+        key = min(a, b) * n + max(a, b)
+        at = int(np.searchsorted(self.edge_keys, key))
+        return at < self.edge_keys.shape[0] and int(self.edge_keys[at]) == key
+
+    def fit(self, bstones: list[int], borders: list[tuple[int, int]]) -> bool:
+        """Whether the source's BSTONE/BORDER lines still describe the scene's corners/arcs.
+
+        A BSTONE on an arc must be at a corner (else it would make one), a BORDER must start
+        at a corner along an arc edge. A surface not read from GOCAD without any gets them.
+        """
+        if not bstones and not borders:
+            return gocad_metadata(self.surface).get("type") == "TSurf"
+        if any(self.on_arc[v] and not self.is_corner[v] for v in bstones):
+            return False
+        return all(self.is_corner[a] and self.on_arc[b] and self._is_edge(a, b) for a, b in borders)
+
+    def derived(self) -> tuple[list[int], list[tuple[int, int]]]:
+        """A BSTONE at every corner, a BORDER from one end of every arc, in this surface."""
+        near_start = self._near(np.array([a.points[0] for a in self.arcs]).reshape(-1, 3))
+        near_next = self._near(np.array([a.points[1] for a in self.arcs]).reshape(-1, 3))
+        borders: list[tuple[int, int]] = []
+        for starts, nexts in zip(near_start, near_next, strict=True):
+            pair = next(((a, b) for a in starts for b in nexts if self._is_edge(a, b)), None)
+            if pair is not None:
+                borders.append(pair)
+        bstones = set(np.flatnonzero(self.is_corner).tolist()) | {a for a, _ in borders}
+        return sorted(bstones), borders
+
+
+def _written_labels(surface: Surface) -> NDArray[np.int64]:
+    """The patch labels that have triangles, ascending (one TFACE each)."""
+    if surface.n_faces == 0:
+        return np.zeros(0, dtype=np.int64)
+    if surface.patch_labels is None:
+        return np.zeros(1, dtype=np.int64)
+    return np.unique(np.asarray(surface.patch_labels, dtype=np.int64))
+
+
+def _kind_header(surface: Surface, tface_type: str | None) -> tuple[tuple[str, str], ...]:
+    """``geobrep_kind`` when the GOCAD type written for ``surface`` does not say its kind."""
+    from geobrep.adapters.gocad.reader import kind_of
+
+    if surface.kind is None:
+        return ()
+    geology = gocad_metadata(surface).get("geology") or {}
+    written = geology.get("GEOLOGICAL_TYPE")
+    if written is None:
+        written = tface_type if tface_type is not None else _TYPE_OF_KIND.get(surface.kind)
+    if kind_of(written) == surface.kind:
+        return ()
+    return ((KIND_KEY, surface.kind),)
 
 
 def _model_name(surface: Surface) -> str:
@@ -627,7 +744,8 @@ def write_gocad(scene: Scene, path: Path, options: GocadOptions | None = None) -
             raise FormatError(f"unknown GOCAD object type {object_type!r}", target)
         for item in scene.entities:
             if isinstance(item, wanted):
-                text = writer.entity(item)
+                # a TSolid's SURFACEs are TSurfs of their own when the TSolid is not written
+                text = writer.tsurf(item) if isinstance(item, Surface) else writer.entity(item)
                 if text is not None:
                     pieces.append(text)
         others = [
