@@ -281,7 +281,8 @@ class _Builder:
                     metadata["color"] = color
                 break
         geo_type = obj.geology.get("GEOLOGICAL_TYPE")
-        return {"name": obj.name, "kind": kind_of(geo_type), "metadata": metadata}
+        kind = obj.header_value("geobrep_kind") or kind_of(geo_type)  # kinds GOCAD has no type for
+        return {"name": obj.name, "kind": kind, "metadata": metadata}
 
     # -- one object -----------------------------------------------------------------------------
     def _add_entity(self, obj: GocadObject) -> None:
