@@ -455,6 +455,8 @@ def to_geodataframe(entities: Scene | Entity | Iterable[Entity], crs: Any = None
     Columns are those of the GIS writers (``entity_id``, ``entity``, ``entity_type``, ``kind``,
     ``block_id``, ``unit_name``, ``horizon_name``, properties); ``layer`` says which layer a row
     would go to. The CRS is the scene's (or ``crs``: a CRS or anything pyproj accepts).
+    Sections in their plane's coordinates (``metadata["section_frame"]``) are in no map CRS:
+    alone they give a frame without a CRS, beside other entities they are left out (warning).
 
     >>> import geobrep
     >>> pts = geobrep.PointSet(vertices=[[1.0, 2.0, 3.0]], point_data={"a": [7.0]}, name="p")
@@ -475,6 +477,21 @@ def to_geodataframe(entities: Scene | Entity | Iterable[Entity], crs: Any = None
         items = [entities]
     else:
         items = list(entities)  # type: ignore[arg-type]
+    plane = [e for e in items if "section_frame" in e.metadata]
+    only_plane = bool(plane) and len(plane) == len(items)
+    if plane and not only_plane:
+        import warnings
+
+        from geobrep.feature_tables import FeatureWarning
+
+        layers = sorted({str(e.metadata.get("layer")) for e in plane})
+        warnings.warn(
+            f"left out {len(plane)} entities in section-plane coordinates (layers "
+            f"{', '.join(layers)}): one GeoDataFrame has one CRS; convert them on their own",
+            FeatureWarning,
+            stacklevel=2,
+        )
+        items = [e for e in items if "section_frame" not in e.metadata]
     tables = entities_to_tables(items)
     frames = []
     for table in tables.values():
@@ -494,6 +511,8 @@ def to_geodataframe(entities: Scene | Entity | Iterable[Entity], crs: Any = None
                 columns[name] = values
         frames.append(geopandas.GeoDataFrame(columns, geometry=list(table.geometry)))
     crs_value = _crs_text(as_crs(crs) if crs is not None else (scene.crs if scene else None))
+    if only_plane:
+        crs_value = None  # along-section coordinates are in no map CRS
     if not frames:
         return geopandas.GeoDataFrame({"layer": []}, geometry=[], crs=crs_value)
     frame = pandas.concat(frames, ignore_index=True)

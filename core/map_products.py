@@ -6,7 +6,8 @@
 - :func:`top_traces`: where each fault or horizon meets the top (topographic) surface, as
   :class:`~geobrep.entities.PolyLine` (layer ``traces``);
 - :func:`block_sections`: horizontal or vertical sections as polygons per block (layer
-  ``sections``);
+  ``sections``), in world coordinates and/or in the section plane's own coordinates (layer
+  ``sections_plane``; :class:`SectionFrame`, :func:`to_section_plane`, :func:`from_section_plane`);
 - :func:`map_products`: all of them in one scene with the model's CRS, e.g. for a GeoPackage.
 
 Every product carries ``block`` / ``unit_name`` / ``horizon`` / ``surface`` in its metadata,
@@ -23,25 +24,46 @@ UTM-scale coordinates keep full precision. shapely (the ``gis`` extra) does the 
 from __future__ import annotations
 
 import importlib
+import math
+import re
 from collections.abc import Iterable, Sequence
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-from geobrep.entities import Block, Polygon, PolyLine, Surface
-from geobrep.errors import DegenerateGeometryError, EntityNotFoundError, MissingDependencyError
+from geobrep.entities import Block, Entity, Polygon, PolyLine, Surface, VertexEntity
+from geobrep.errors import (
+    DegenerateGeometryError,
+    EntityNotFoundError,
+    MissingDependencyError,
+    OptionsError,
+)
 from geobrep.geometry import Plane, mesh
+from geobrep.model import FrozenModel
 from geobrep.scene import Scene
 
 __all__ = [
+    "SECTION_FRAME_KEY",
+    "SectionCoordinates",
+    "SectionFrame",
     "block_outlines",
     "block_sections",
+    "from_section_plane",
     "level_set_segments",
     "map_products",
+    "section_frame",
     "surface_outlines",
+    "to_section_plane",
     "top_traces",
 ]
+
+#: Where sections go: ``world`` (map coordinates, as cut), ``plane`` (the section plane's own
+#: coordinates for every plane that is not horizontal), or ``both``.
+SectionCoordinates = Literal["world", "plane", "both"]
+
+#: Metadata key of an entity (and of a GeoPackage layer) in section-plane coordinates.
+SECTION_FRAME_KEY = "section_frame"
 
 #: Relative tolerance (of the model's diagonal) for "on the surface" / "on the plane".
 RELATIVE_TOLERANCE = 1e-9
@@ -384,14 +406,156 @@ def top_traces(
     return traces
 
 
+# -- section-plane coordinates -------------------------------------------------------------------
+class SectionFrame(FrozenModel):
+    """The frame of a section plane: ``world = origin + along·a + elevation·u + offset·n``.
+
+    ``along`` is the horizontal unit vector of the section line (pointing east, or north for a
+    north-south line), ``up`` the in-plane unit vector pointing upwards (``(0, 0, 1)`` for a
+    vertical plane, so the second coordinate is the elevation: ``origin`` has z = 0), ``normal``
+    = ``along × up``. Points of the section have offset 0. ``origin`` is where the section line
+    starts (distance along 0 at the first point of the section).
+
+    >>> frame = section_frame(Plane.y(100.0), [[5.0, 100.0, -3.0], [9.0, 100.0, 2.0]])
+    >>> frame.origin, frame.along, frame.up
+    ((5.0, 100.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    >>> frame.to_plane([[9.0, 100.0, 2.0]]).tolist()
+    [[4.0, 2.0, 0.0]]
+    """
+
+    origin: tuple[float, float, float]
+    along: tuple[float, float, float]
+    up: tuple[float, float, float]
+    normal: tuple[float, float, float]
+
+    @property
+    def rotation(self) -> NDArray[np.float64]:
+        """``(3, 3)`` rows ``along``, ``up``, ``normal`` (orthonormal, determinant +1)."""
+        return np.array([self.along, self.up, self.normal], dtype=np.float64)
+
+    def to_plane(self, points: ArrayLike) -> NDArray[np.float64]:
+        """``(N, 3)`` world points as (distance along, elevation, offset from the plane)."""
+        xyz = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        local: NDArray[np.float64] = (xyz - np.asarray(self.origin)) @ self.rotation.T
+        return local
+
+    def to_world(self, points: ArrayLike) -> NDArray[np.float64]:
+        """``(N, 3)`` plane coordinates (along, elevation, offset) back to world points."""
+        local = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        world: NDArray[np.float64] = local @ self.rotation + np.asarray(self.origin)
+        return world
+
+
+def section_frame(plane: Plane, points: ArrayLike | None = None) -> SectionFrame:
+    """The :class:`SectionFrame` of a plane that is not horizontal; ``points`` (the section's
+    vertices) place the origin at the start of the section line (default: the plane's point
+    nearest to the world origin, at z = 0).
+
+    A horizontal plane has no section line (its sections are map views already): a
+    :class:`~geobrep.errors.DegenerateGeometryError`.
+    """
+    normal = plane.normal
+    along = np.cross(normal, [0.0, 0.0, 1.0])
+    length = float(np.linalg.norm(along))
+    if length < 1e-12:
+        raise DegenerateGeometryError(
+            f"plane {plane.coefficients.tolist()} is horizontal: its sections are map views, "
+            "drawn in world coordinates"
+        )
+    along /= length
+    if along[0] < -1e-12 or (abs(along[0]) <= 1e-12 and along[1] < 0):
+        along = -along  # sections read west to east (south to north for a north-south line)
+    along[np.abs(along) < 1e-15] = 0.0
+    up = np.cross(along, normal)
+    if up[2] < 0:
+        up = -up
+    up /= np.linalg.norm(up)
+    up[np.abs(up) < 1e-15] = 0.0
+    normal_out = np.cross(along, up)
+    xyz = None if points is None else np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    base = plane.point if xyz is None or xyz.shape[0] == 0 else xyz.mean(axis=0)
+    base = base - (float(normal @ base) + plane.d / math.hypot(plane.a, plane.b, plane.c)) * normal
+    origin = base - (base[2] / up[2]) * up  # on the plane, at z = 0
+    if xyz is not None and xyz.shape[0]:
+        origin = origin + float(((xyz - origin) @ along).min()) * along
+    origin[2] = 0.0 if abs(origin[2]) < 1e-9 * max(1.0, float(np.abs(origin).max())) else origin[2]
+    return SectionFrame(
+        origin=(float(origin[0]), float(origin[1]), float(origin[2])),
+        along=(float(along[0]), float(along[1]), float(along[2])),
+        up=(float(up[0]), float(up[1]), float(up[2])),
+        normal=(float(normal_out[0]), float(normal_out[1]), float(normal_out[2])),
+    )
+
+
+def to_section_plane(entities: Iterable[Entity], frame: SectionFrame) -> list[Entity]:
+    """Section entities moved into ``frame``'s coordinates (along, elevation, offset).
+
+    Each gets ``metadata["section_frame"]`` (the frame) and the layer ``<layer>_plane`` (the
+    layer of :func:`block_sections` products, or ``sections``); ids are dropped. Entities
+    without vertices are left out. :func:`from_section_plane` undoes it.
+    """
+    moved: list[Entity] = []
+    for entity in entities:
+        if not isinstance(entity, VertexEntity):
+            continue
+        metadata = dict(entity.metadata)
+        layer = metadata.get("layer")
+        metadata["layer"] = f"{layer if isinstance(layer, str) and layer else 'sections'}_plane"
+        metadata[SECTION_FRAME_KEY] = frame.model_dump(mode="json")
+        vertices = frame.to_plane(entity.vertices)  # type: ignore[attr-defined]
+        moved.append(entity.replace(id=None, vertices=vertices, metadata=metadata))
+    return moved
+
+
+_PLANE_LAYER = re.compile(r"_plane(_\d+)?$")
+
+
+def from_section_plane(entities: Iterable[Entity]) -> list[Entity]:
+    """Entities in section-plane coordinates (``metadata["section_frame"]``) back in world
+    coordinates, in their world layer; other entities are returned as they are.
+
+    >>> import geobrep
+    >>> cake = geobrep.datasets.faulted_layer_cake()
+    >>> world = block_sections(cake, [Plane.x(450_700.0)])
+    >>> plane = block_sections(cake, [Plane.x(450_700.0)], section_coordinates="plane")
+    >>> back = from_section_plane(plane)
+    >>> bool(max(abs(b.vertices - w.vertices).max() for b, w in zip(back, world)) < 1e-9)
+    True
+    """
+    result: list[Entity] = []
+    for entity in entities:
+        stored = entity.metadata.get(SECTION_FRAME_KEY)
+        if stored is None or not isinstance(entity, VertexEntity):
+            result.append(entity)
+            continue
+        frame = SectionFrame.model_validate(stored)
+        metadata = {k: v for k, v in entity.metadata.items() if k != SECTION_FRAME_KEY}
+        layer = metadata.get("layer")
+        if isinstance(layer, str):
+            metadata["layer"] = _PLANE_LAYER.sub("", layer)
+        vertices = frame.to_world(entity.vertices)  # type: ignore[attr-defined]
+        result.append(entity.replace(id=None, vertices=vertices, metadata=metadata))
+    return result
+
+
 def block_sections(
-    scene: Scene, planes: Iterable[Plane], *, with_traces: bool = False
+    scene: Scene,
+    planes: Iterable[Plane],
+    *,
+    with_traces: bool = False,
+    section_coordinates: SectionCoordinates = "world",
 ) -> list[Polygon | PolyLine]:
     """The section of every block by each plane: one Polygon (with holes) per block and plane.
 
     The cutting is :func:`geobrep.clipping.section` (the registered clippers); each polygon gets
     ``layer="sections"``, the block id and unit, and the plane's coefficients. With
     ``with_traces`` the section lines of the open surfaces come too (layer ``section_lines``).
+
+    ``section_coordinates`` says where the sections of planes that are not horizontal go:
+    ``"world"`` (map coordinates: a vertical section has no area in map view), ``"plane"``
+    (the plane's own coordinates, see :class:`SectionFrame`: valid polygons a GIS can draw, in
+    layer ``sections_plane``, or ``sections_plane_<k>`` for the k-th such plane when there are
+    several), or ``"both"``. Horizontal sections are always in world coordinates.
 
     >>> import geobrep
     >>> cake = geobrep.datasets.faulted_layer_cake()
@@ -401,23 +565,43 @@ def block_sections(
     """
     from geobrep.clipping import section
 
+    if section_coordinates not in ("world", "plane", "both"):
+        raise OptionsError(
+            f"section_coordinates={section_coordinates!r}: choose 'world', 'plane' or 'both'"
+        )
+    planes = list(planes)
+    upright = [p for p in planes if float(np.hypot(p.normal[0], p.normal[1])) >= 1e-12]
     products: list[Polygon | PolyLine] = []
     for plane in planes:
         coefficients = [float(plane.a), float(plane.b), float(plane.c), float(plane.d)]
         panel = section(scene, plane)
         if panel is None:
             continue
+        cut: list[Polygon | PolyLine] = []
         for entity in panel.entities:
             metadata = dict(entity.metadata)
             metadata["plane"] = coefficients
             if isinstance(entity, Polygon) and entity.kind == "section":
                 metadata["layer"] = "sections"
-                products.append(entity.replace(id=None, metadata=metadata))
+                cut.append(entity.replace(id=None, metadata=metadata))
             elif with_traces and isinstance(entity, PolyLine):
                 metadata["layer"] = "section_lines"
                 if entity.kind == "horizon":
                     metadata["horizon"] = entity.name
-                products.append(entity.replace(id=None, metadata=metadata))
+                cut.append(entity.replace(id=None, metadata=metadata))
+        if plane not in upright or section_coordinates == "world":
+            products += cut
+            continue
+        if section_coordinates == "both":
+            products += cut
+        frame = section_frame(plane, np.concatenate([e.vertices for e in cut]) if cut else None)
+        for entity in to_section_plane(cut, frame):
+            if len(upright) > 1:
+                layer = str(entity.metadata["layer"])
+                number = next(k for k, p in enumerate(upright, 1) if p is plane)
+                entity = entity.replace(metadata={**entity.metadata, "layer": f"{layer}_{number}"})
+            assert isinstance(entity, Polygon | PolyLine)
+            products.append(entity)
     return products
 
 
@@ -429,12 +613,17 @@ def map_products(
     section_planes: Sequence[Plane] = (),
     elevation: float = 0.0,
     with_section_lines: bool = False,
+    section_coordinates: SectionCoordinates = "both",
 ) -> Scene:
     """Block outlines, top traces and sections of a model in one scene (the model's CRS).
 
     ``section_levels`` are z values of horizontal sections, ``section_planes`` any other
     planes (vertical sections); ``top=None`` skips the traces; ``with_section_lines`` adds the
     lines where horizons, faults and boundaries cross the section planes.
+    ``section_coordinates`` (see :func:`block_sections`): by default the sections of vertical
+    and inclined planes come both in world coordinates (layer ``sections``) and in their
+    plane's coordinates (layer ``sections_plane``, with ``metadata["section_frame"]``; the GIS
+    writers store the frame in the layer's metadata and write such layers without the CRS).
 
     >>> import geobrep
     >>> cake = geobrep.datasets.faulted_layer_cake()
@@ -447,5 +636,10 @@ def map_products(
         entities += top_traces(scene, top=top)
     planes = [Plane.z(level) for level in section_levels] + list(section_planes)
     if planes:
-        entities += block_sections(scene, planes, with_traces=with_section_lines)
+        entities += block_sections(
+            scene,
+            planes,
+            with_traces=with_section_lines,
+            section_coordinates=section_coordinates,
+        )
     return Scene(entities=entities, crs=scene.crs, name=f"{scene.name} map".strip())

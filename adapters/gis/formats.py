@@ -4,6 +4,11 @@ A GeoPackage holds several layers and the full geobrep CRS (in the dataset metad
 GDAL's own CRS); a GeoJSON file holds one FeatureCollection, so several layers are written into
 it with a ``layer`` column that the reader splits again; a shapefile holds one layer (choose it
 with ``layer=`` when a scene makes several).
+
+Sections in their plane's coordinates (``metadata["section_frame"]``, see
+:func:`geobrep.map_products.to_section_plane`) go to GeoPackage layers without a CRS, the frame
+in the layer metadata (``geobrep_section_frame``, JSON); GeoJSON and shapefiles cannot say what
+such coordinates are, so those entities are left out there with a warning.
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ from geobrep.feature_tables import (
     entities_to_tables,
     tables_to_entities,
 )
+from geobrep.map_products import SECTION_FRAME_KEY
 from geobrep.registry import FormatCapabilities, FormatSpec
 from geobrep.scene import Scene
 
@@ -38,6 +44,8 @@ __all__ = ["GisOptions", "gis_formats", "looks_like_geojson", "read_gis", "write
 
 #: Dataset metadata key of the GeoPackage that keeps the complete geobrep CRS.
 CRS_METADATA_KEY = "geobrep_crs"
+#: Layer metadata key of a GeoPackage layer in section-plane coordinates (a SectionFrame as JSON).
+FRAME_METADATA_KEY = "geobrep_section_frame"
 LAYER_COLUMN = "layer"
 _GEOMETRY_TYPES = {0: "Point Z", 1: "LineString Z", 2: "LineString Z", 3: "Polygon Z"}
 _DRIVERS = {"gpkg": "GPKG", "geojson": "GeoJSON", "shapefile": "ESRI Shapefile"}
@@ -224,15 +232,20 @@ def read_gis(path: Path, options: GisOptions, driver: str) -> Scene:
     stored = _stored_crs(pyogrio.read_info(path, layer=names[0])) if names else None
     tables: list[FeatureTable] = []
     crs_by_layer: dict[str, str | None] = {}
+    frames: dict[str, Any] = {}
     for name in names:
         if options.layer is not None and driver != "GeoJSON" and name != options.layer:
             continue
+        frame = _layer_frame(path, name) if driver == "GPKG" else None
         layer_tables, crs_text = _read_layer(path, name, driver)
         for table in layer_tables:
             if options.layer is not None and table.layer != options.layer:
                 continue
             tables.append(table)
-            crs_by_layer[table.layer] = crs_text
+            if frame is not None:
+                frames[table.layer] = frame  # section-plane coordinates: no CRS, by design
+            else:
+                crs_by_layer[table.layer] = crs_text
     if options.layer is not None and not tables:
         raise FormatError(f"no layer {options.layer!r}", path)
     known = {text for text in crs_by_layer.values() if text}
@@ -253,7 +266,28 @@ def read_gis(path: Path, options: GisOptions, driver: str) -> Scene:
     if driver == "GeoJSON":
         crs = _geojson_crs(path, crs)
     entities = tables_to_entities(tables, options, source=str(path))
+    if frames:
+        entities = [
+            e.replace(metadata={**e.metadata, SECTION_FRAME_KEY: frames[str(e.metadata["layer"])]})
+            if e.metadata.get("layer") in frames
+            else e
+            for e in entities
+        ]
     return Scene(entities=entities, crs=crs, name=path.stem)
+
+
+def _layer_frame(path: Path, layer: str) -> Any:
+    """The section frame a GeoPackage layer's metadata holds, or None."""
+    from geobrep.map_products import SectionFrame
+
+    info = _pyogrio().read_info(path, layer=layer)
+    text = (info.get("layer_metadata") or {}).get(FRAME_METADATA_KEY)
+    if not text:
+        return None
+    try:
+        return SectionFrame.model_validate(json.loads(text)).model_dump(mode="json")
+    except (ValueError, TypeError) as exc:
+        raise FormatError(f"layer {layer!r}: unreadable {FRAME_METADATA_KEY}: {exc}", path) from exc
 
 
 # -- writing ------------------------------------------------------------------------------------
@@ -295,7 +329,13 @@ def _merged_for_single_layer(tables: list[FeatureTable]) -> FeatureTable:
     )
 
 
-def _write_tables(tables: list[FeatureTable], path: Path, driver: str, crs: CRS | None) -> None:
+def _write_tables(
+    tables: list[FeatureTable],
+    path: Path,
+    driver: str,
+    crs: CRS | None,
+    frames: dict[str, str] | None = None,
+) -> None:
     pyogrio = _pyogrio()
     shapely = importlib.import_module("shapely")
 
@@ -305,6 +345,9 @@ def _write_tables(tables: list[FeatureTable], path: Path, driver: str, crs: CRS 
         kwargs: dict[str, Any] = {}
         if driver == "GPKG" and position == 0 and crs is not None:
             kwargs["dataset_metadata"] = {CRS_METADATA_KEY: crs.model_dump_json()}
+        frame = (frames or {}).get(table.layer)
+        if frame is not None:
+            kwargs["layer_metadata"] = {FRAME_METADATA_KEY: frame}
         if driver == "GeoJSON":
             kwargs["layer_options"] = {"WRITE_NAME": "YES", "SIGNIFICANT_FIGURES": "17"}
         with warnings.catch_warnings():
@@ -320,7 +363,7 @@ def _write_tables(tables: list[FeatureTable], path: Path, driver: str, crs: CRS 
                 layer=table.layer,
                 driver=driver,
                 geometry_type=_geometry_type(table),
-                crs=crs_text,
+                crs=crs_text if frame is None else None,
                 append=position > 0,
                 promote_to_multi=False,
                 **kwargs,
@@ -348,6 +391,54 @@ def _shapefile_write(table: FeatureTable, path: Path, crs: CRS | None) -> None:
         shutil.move(str(staging), str(path))
 
 
+def _plane_frames(
+    scene: Scene, tables: list[FeatureTable], path: Path, driver: str
+) -> tuple[list[FeatureTable], dict[str, str]]:
+    """The section frame (JSON) of each table in section-plane coordinates; GeoJSON and
+    shapefile tables of such entities are left out with a warning (no place for the frame)."""
+    frames = {
+        int(e.id or 0): json.dumps(e.metadata[SECTION_FRAME_KEY], sort_keys=True)
+        for e in scene.entities
+        if SECTION_FRAME_KEY in e.metadata
+    }
+    if not frames:
+        return tables, {}
+    kept: list[FeatureTable] = []
+    by_layer: dict[str, str] = {}
+    dropped: list[str] = []
+    for table in tables:
+        ids = np.asarray(table.columns["entity_id"]).tolist()
+        found = {frames[i] for i in ids if i in frames}
+        if not found:
+            kept.append(table)
+            continue
+        if len(found) > 1 or any(i not in frames for i in ids):
+            raise FormatError(
+                f"layer {table.layer!r} mixes world coordinates and section-plane coordinates "
+                "(or several section planes): give each section plane its own layer",
+                path,
+            )
+        if driver != "GPKG":
+            dropped.append(table.layer)
+            continue
+        by_layer[table.layer] = found.pop()
+        kept.append(table)
+    if dropped and not kept:
+        raise FormatError(
+            f"layer(s) {', '.join(repr(d) for d in dropped)} are in section-plane coordinates: "
+            f"{driver} cannot store their frame (write a GeoPackage)",
+            path,
+        )
+    if dropped:
+        warnings.warn(
+            f"{_final_name(path)}: left out layer(s) {', '.join(repr(d) for d in dropped)} in "
+            f"section-plane coordinates: {driver} cannot store their frame (write a GeoPackage)",
+            FeatureWarning,
+            stacklevel=4,
+        )
+    return kept, by_layer
+
+
 def write_gis(scene: Scene, path: Path, options: GisOptions, driver: str) -> None:
     """Write the scene's points, lines, polygons and annotations as layers."""
     tables = list(entities_to_tables(scene.entities).values())
@@ -355,6 +446,7 @@ def write_gis(scene: Scene, path: Path, options: GisOptions, driver: str) -> Non
         tables = [t for t in tables if t.layer == options.layer]
         if not tables:
             raise FormatError(f"the scene has no entities for layer {options.layer!r}", path)
+    tables, frames = _plane_frames(scene, tables, path, driver)
     if not tables:
         raise FormatError(
             "nothing to write: GIS layers hold PointSets, PolyLines, Polygons and Annotations",
@@ -378,7 +470,7 @@ def write_gis(scene: Scene, path: Path, options: GisOptions, driver: str) -> Non
             )
         _shapefile_write(tables[0], path, scene.crs)
     else:
-        _write_tables(tables, path, driver, scene.crs)
+        _write_tables(tables, path, driver, scene.crs, frames)
 
 
 def _reader(driver: str) -> Any:
