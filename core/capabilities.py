@@ -15,22 +15,66 @@
 from __future__ import annotations
 
 from collections import Counter
+from pathlib import Path
 from typing import Any
 
-from geobrep.registry import FormatCapabilities, FormatRegistry
+from geobrep.entities import Entity
+from geobrep.entities.base import VertexEntity
+from geobrep.registry import FormatCapabilities, FormatRegistry, FormatSpec
 from geobrep.scene import Group, Scene
 
-__all__ = ["capability_losses", "capability_table", "restrict_scene"]
+__all__ = [
+    "SKIPPED_ON_READ",
+    "capability_losses",
+    "capability_table",
+    "format_losses",
+    "has_geometry",
+    "read_losses",
+    "restrict_scene",
+    "without_read_losses",
+]
+
+SKIPPED_ON_READ = "skipped_on_read"
+"""Scene metadata key: a reader's list of what the file held and it did not read."""
+
+
+def has_geometry(entity: Entity) -> bool:
+    """False for a vertex entity without vertices (a GOCAD header-only object)."""
+    return not isinstance(entity, VertexEntity) or entity.n_points > 0
+
+
+def read_losses(scene: Scene) -> list[str]:
+    """What the reader of ``scene`` skipped, one sentence each (from its metadata)."""
+    skipped = scene.metadata.get(SKIPPED_ON_READ)
+    if not isinstance(skipped, list | tuple):
+        return []
+    return [f"skipped on read: {item}" for item in skipped]
+
+
+def without_read_losses(scene: Scene) -> Scene:
+    """``scene`` without the reader's skipped list (it describes the source, not the target)."""
+    if SKIPPED_ON_READ not in scene.metadata:
+        return scene
+    metadata = {k: v for k, v in scene.metadata.items() if k != SKIPPED_ON_READ}
+    return scene.model_copy(update={"metadata": metadata})
 
 
 def capability_losses(scene: Scene, caps: FormatCapabilities) -> list[str]:
-    """One sentence per kind of content ``caps`` cannot hold (empty: nothing is lost)."""
-    lost: list[str] = []
+    """One sentence per kind of content ``caps`` cannot hold (empty: nothing is lost).
+
+    What the reader skipped (:func:`read_losses`) comes first: it is lost too.
+    """
+    lost: list[str] = read_losses(scene)
     dropped = Counter(e.type for e in scene.entities if e.type not in caps.entity_types)
     held = ", ".join(sorted(caps.entity_types)) or "no entities"
     for type_name, count in sorted(dropped.items()):
         lost.append(f"{count} {type_name} entities dropped (format holds {held})")
     kept = [e for e in scene.entities if e.type in caps.entity_types]
+    if not caps.empty_entities:
+        empty = [e.label for e in kept if not has_geometry(e)]
+        if empty:
+            lost.append(f"{len(empty)} entities without geometry dropped: {', '.join(empty)}")
+        kept = [e for e in kept if has_geometry(e)]
     if scene.patches and not caps.topology:
         lost.append(f"topology dropped ({len(scene.patches)} patches)")
     if scene.crs is not None and not caps.crs:
@@ -57,11 +101,25 @@ def capability_losses(scene: Scene, caps: FormatCapabilities) -> list[str]:
     return lost
 
 
+def format_losses(scene: Scene, spec: FormatSpec, target: Path) -> list[str]:
+    """Everything writing ``scene`` to ``target`` in format ``spec`` loses, one sentence each.
+
+    :func:`capability_losses`, then what the format says it drops for this target
+    (:attr:`~geobrep.registry.FormatSpec.losses`, e.g. the object type of a GOCAD extension).
+    """
+    lost = capability_losses(scene, spec.capabilities)
+    if spec.losses is not None:
+        lost.extend(spec.losses(restrict_scene(scene, spec.capabilities), target))
+    return lost
+
+
 def restrict_scene(scene: Scene, caps: FormatCapabilities) -> Scene:
     """``scene`` without what ``caps`` cannot hold (entities of other types, properties)."""
     kept = []
     for entity in scene.entities:
         if entity.type not in caps.entity_types:
+            continue
+        if not caps.empty_entities and not has_geometry(entity):
             continue
         changes: dict[str, Any] = {}
         if not caps.point_data and entity.point_data:

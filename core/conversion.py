@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import glob
 import importlib
+import re
 import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -28,9 +29,11 @@ from typing import Any, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict
 
-from geobrep.capabilities import capability_losses
-from geobrep.errors import FileAccessError, GeobrepError, OptionsError
+from geobrep.capabilities import format_losses, has_geometry, restrict_scene, without_read_losses
+from geobrep.errors import FileAccessError, FormatError, GeobrepError, OptionsError
 from geobrep.io import read, write
+from geobrep.registry import FormatCapabilities
+from geobrep.scene import Scene
 
 __all__ = [
     "ConversionSummary",
@@ -40,6 +43,7 @@ __all__ = [
     "demo_stage",
     "expand",
     "run_each",
+    "verify_read_back",
 ]
 
 PathArg = str | PathLike[str]
@@ -132,16 +136,34 @@ def convert_file(
     read_format: str | None = None,
     write_format: str | None = None,
     write_options: dict[str, Any] | None = None,
+    verify: bool = False,
 ) -> FileReport:
-    """Convert one file; never raises: a failure is a report with ``error`` set."""
+    """Convert one file; never raises: a failure is a report with ``error`` set.
+
+    ``verify`` reads the written file back: anything missing that the report does not list
+    as lost makes the file fail.
+    """
     started = time.perf_counter()
     try:
         from geobrep.plugins import registries
 
         scene = read(source, format=read_format)
         spec = registries().formats.choose_writer(target, write_format)
-        lost = capability_losses(scene, spec.capabilities)
+        lost = format_losses(scene, spec, target)
+        scene = without_read_losses(scene)  # it describes the source, not what is written
         write(scene, target, format=spec.name, **(write_options or {}))
+        if verify:
+            try:
+                back = read(target, format=spec.name)
+            except GeobrepError as exc:
+                raise FormatError(f"verify: the written file cannot be read back: {exc}") from exc
+            problems = verify_read_back(scene, back, spec.capabilities, lost)
+            if problems:
+                raise FormatError(
+                    f"verify: {target.name} read back differs from the report: "
+                    + "; ".join(problems[:5])
+                    + (f" (and {len(problems) - 5} more)" if len(problems) > 5 else "")
+                )
     except GeobrepError as exc:
         return _failed(source, target, str(exc), started)
     except Exception as exc:  # a bug or a library failure: still this file's problem only
@@ -154,6 +176,69 @@ def convert_file(
         entities=len(scene.entities),
         seconds=time.perf_counter() - started,
     )
+
+
+def verify_read_back(
+    written: Scene, back: Scene, caps: FormatCapabilities, lost: Sequence[str]
+) -> list[str]:
+    """What ``back`` (a file read back) lacks of ``written`` that ``lost`` does not explain.
+
+    Compared, as far as ``caps`` holds them: the entities of each type, and per entity its
+    vertex and cell counts, name, id and property names. Empty when the report is true.
+
+    >>> import geobrep
+    >>> scene = geobrep.datasets.faulted_layer_cake()
+    >>> caps = geobrep.plugins.registries().formats.get("native").capabilities
+    >>> verify_read_back(scene, scene, caps, [])
+    []
+    """
+    kept = restrict_scene(written, caps).entities
+    dropped = {
+        match.group(1)
+        for sentence in lost
+        if (match := re.match(r"\d+ (\w+) entities dropped", sentence)) is not None
+    }
+    kept = tuple(e for e in kept if e.type not in dropped)
+    problems: list[str] = []
+    merged = len(kept) > 1 and not caps.multiple_entities
+    if merged:
+        if len(back.entities) != 1:
+            problems.append(f"{len(kept)} entities merged into one: {len(back.entities)} read")
+        return problems
+    for type_name in sorted({e.type for e in kept} | {e.type for e in back.entities}):
+        want = [e for e in kept if e.type == type_name]
+        got = [e for e in back.entities if e.type == type_name]
+        if len(want) != len(got):
+            problems.append(f"{len(got)} {type_name} entities read, {len(want)} written")
+            continue
+        for entity, other in zip(want, got, strict=True):
+            problems.extend(_entity_problems(entity, other, caps, lost))
+    return problems
+
+
+def _entity_problems(
+    entity: Any, other: Any, caps: FormatCapabilities, lost: Sequence[str]
+) -> list[str]:
+    where = entity.label
+    problems = []
+    if has_geometry(entity) or has_geometry(other):
+        if other.n_points != entity.n_points:
+            problems.append(f"{where}: {other.n_points} points read, {entity.n_points} written")
+        if other.n_cells != entity.n_cells:
+            problems.append(f"{where}: {other.n_cells} cells read, {entity.n_cells} written")
+    if caps.names and other.name != entity.name:
+        problems.append(f"{where}: read back named {other.name!r}")
+    if caps.ids and other.id != entity.id:
+        problems.append(f"{where}: read back with id {other.id}")
+    for field, able in (("point_data", caps.point_data), ("cell_data", caps.cell_data)):
+        missing = sorted(
+            name
+            for name in set(getattr(entity, field)) - set(getattr(other, field))
+            if not any(name in sentence for sentence in lost)  # reported: renamed, split
+        )
+        if able and missing:
+            problems.append(f"{where}: {field} {', '.join(missing)} not read back")
+    return problems
 
 
 def _failed(source: Path, target: Path | None, error: str, started: float) -> FileReport:
@@ -217,6 +302,7 @@ def convert(
     read_format: str | None = None,
     write_options: dict[str, Any] | None = None,
     progress: Progress | None = None,
+    verify: bool = False,
 ) -> ConversionSummary:
     """Convert files; returns the per-file reports (it never stops at a bad file).
 
@@ -225,7 +311,9 @@ def convert(
     ``to`` names a registered format (or an extension); ``jobs`` runs that many worker
     processes; ``client`` (a ``dask.distributed.Client`` or a scheduler address such as
     ``"tcp://scheduler:8786"``) runs the files on a Dask cluster instead. ``progress(report,
-    done, total)`` is called as each file finishes.
+    done, total)`` is called as each file finishes. ``verify=True`` reads each written file
+    back and fails the file when something is missing that its report does not list as lost
+    (see :func:`verify_read_back`).
 
     Raises:
         OptionsError: contradictory arguments (several inputs and one output file, no format).
@@ -254,7 +342,7 @@ def convert(
             progress(report, len(results), total)
 
     indices = [i for i, t in enumerate(targets) if t is not None]
-    arguments = [(s, t, read_format, write_format, write_options) for s, t in work]
+    arguments = [(s, t, read_format, write_format, write_options, verify) for s, t in work]
 
     def finished(position: int, report: FileReport | None, error: BaseException | None) -> None:
         if report is None:  # the worker died (killed, out of memory)

@@ -220,6 +220,8 @@ class FormatCapabilities(BaseModel):
     topology: bool = False
     crs: bool = False
     multiple_entities: bool = False
+    empty_entities: bool = False
+    """Entities without geometry (a GOCAD header-only object) are kept, not dropped."""
 
 
 class FormatSpec(RegisteredItem):
@@ -241,6 +243,9 @@ class FormatSpec(RegisteredItem):
     writer: Callable[..., Any] | None = None
     sniff: Callable[[bytes], bool] | None = None
     capabilities: FormatCapabilities = FormatCapabilities()
+    losses: Callable[..., list[str]] | None = None
+    """``losses(scene, path) -> [sentence, ...]``: what the writer drops for this target beyond
+    what :attr:`capabilities` says (e.g. a GOCAD .ts holds surfaces only)."""
     generic_content: bool = False
     """The sniffer recognises generic content (e.g. rows of plain numbers): the format is
     chosen by content only when no other format's sniffer recognises the file."""

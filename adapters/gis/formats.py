@@ -491,6 +491,21 @@ def _looks_like_geopackage(head: bytes) -> bool:
     return head.startswith(b"SQLite format 3\x00") and b"GPKG" in head[60:72]
 
 
+def _losses(scene: Scene, path: Path) -> list[str]:
+    """Vector properties become one attribute column per component (read back as such)."""
+    split = sorted(
+        {
+            f"{name} ({name}_0 ... {name}_{prop.values.shape[1] - 1})"
+            for entity in scene.entities
+            for name, prop in [*entity.point_data.items(), *entity.cell_data.items()]
+            if prop.values.ndim > 1
+        }
+    )
+    if not split:
+        return []
+    return [f"vector properties written as one column per component: {', '.join(split)}"]
+
+
 def gis_formats() -> list[FormatSpec]:
     """The three GIS format specs."""
     capabilities = FormatCapabilities(
@@ -512,6 +527,7 @@ def gis_formats() -> list[FormatSpec]:
             sniff=_looks_like_geopackage,
             options=GisOptions,
             capabilities=capabilities,
+            losses=_losses,
         ),
         FormatSpec(
             name="geojson",
@@ -522,6 +538,7 @@ def gis_formats() -> list[FormatSpec]:
             sniff=looks_like_geojson,
             options=GisOptions,
             capabilities=capabilities,
+            losses=_losses,
         ),
         FormatSpec(
             name="shapefile",
@@ -531,5 +548,6 @@ def gis_formats() -> list[FormatSpec]:
             writer=_writer(_DRIVERS["shapefile"]),
             options=GisOptions,
             capabilities=capabilities,
+            losses=_losses,
         ),
     ]

@@ -42,6 +42,43 @@ def _write(scene: Scene, path: Path, options: object) -> None:
     write_gocad(scene, path, options)
 
 
+#: The entity types each GOCAD object type holds (the writer picks it from the extension).
+_HELD = {
+    ".ts": ("TSurf", frozenset({"Surface"})),
+    ".pl": ("PLine", frozenset({"PolyLine"})),
+    ".vs": ("VSet", frozenset({"PointSet"})),
+    ".so": ("TSolid", frozenset({"TetMesh"})),
+    ".ml": ("Model3d", frozenset({"Surface", "Block"})),
+    ".gp": ("group", frozenset({"Surface", "PolyLine", "PointSet", "TetMesh"})),
+}
+
+
+_FAMILY = frozenset({"Surface", "PolyLine", "PointSet", "TetMesh", "Block"})
+
+
+def _losses(scene: Scene, path: Path) -> list[str]:
+    """What the object type of ``path``'s extension cannot hold (the format holds the rest)."""
+    from geobrep.adapters.gocad.objects import gocad_section
+
+    object_type, held = _HELD.get(path.suffix.lower(), ("", frozenset()))
+    if not held:
+        return []
+    dropped: dict[str, int] = {}
+    for entity in scene.entities:
+        if entity.type in held or entity.type not in _FAMILY:
+            continue  # kept, or reported from the format's capabilities
+        if object_type == "TSolid" and gocad_section(entity.metadata).get("type") == (
+            "TSolid.SURFACE"
+        ):
+            continue
+        dropped[entity.type] = dropped.get(entity.type, 0) + 1
+    kinds = ", ".join(sorted(held))
+    return [
+        f"{count} {type_name} entities dropped (a GOCAD {object_type} file holds {kinds})"
+        for type_name, count in sorted(dropped.items())
+    ]
+
+
 @hookimpl
 def geobrep_register_formats(registry: FormatRegistry) -> None:
     """Register the ``gocad`` format (.ts .pl .vs .so .ml .gp)."""
@@ -65,6 +102,8 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
                 topology=True,
                 crs=True,
                 multiple_entities=True,
+                empty_entities=True,
             ),
+            losses=_losses,
         )
     )

@@ -151,6 +151,8 @@ class _Parser:
     def __init__(self, source: Source) -> None:
         self.source = source
         self.stream = _Stream(source)
+        self.skipped: list[str] = []
+        """What was in the file and is not read (objects of unknown type, skipped blocks)."""
 
     # -- diagnostics ----------------------------------------------------------------------------
     def error(self, message: str, line: int | None) -> FormatError:
@@ -190,7 +192,11 @@ class _Parser:
         kind = KNOWN_TYPES.get(tokens[1].lower())
         if kind is None:
             self.warn(f"skipping GOCAD {tokens[1]} object (no reader for this type)", start.number)
-            self._skip_object()
+            name = self._skip_object()
+            named = f" {name!r}" if name else ""
+            self.skipped.append(
+                f"GOCAD {tokens[1]}{named} (line {start.number}): no reader for this type"
+            )
             return None
         obj = GocadObject(kind, tokens[2] if len(tokens) > 2 else "1", start.number)
         if kind in _CELL_WIDTH or kind in ("VSet",):
@@ -199,19 +205,23 @@ class _Parser:
             self._parse_group(obj)
         return obj
 
-    def _skip_object(self) -> None:
+    def _skip_object(self) -> str | None:
+        """Pass over an object of unknown type; its header ``name`` if it has one."""
+        name = None
         while True:
             item = self.stream.peek()
             if item is None:
-                return
+                return name
             if isinstance(item, Line):
                 keyword = _keyword(item.text)
                 if keyword == "GOCAD":
                     self.warn("object without END before the next 'GOCAD' line", item.number)
-                    return
+                    return name
                 self.stream.take()
                 if keyword == "END":
-                    return
+                    return name
+                if name is None and item.text.lstrip().lower().startswith("name:"):
+                    name = item.text.split(":", 1)[1].strip() or None
             else:
                 self.stream.take()
 
@@ -648,6 +658,7 @@ class _Parser:
     def _skip_block(self, keyword: str, number: int) -> None:
         end = _SKIP_BLOCKS[keyword]
         self.warn(f"skipping {keyword} block", number)
+        self.skipped.append(f"{keyword} block (line {number}): not read")
         while True:
             item = self.stream.take()
             if item is None:
@@ -872,6 +883,13 @@ def _strip_flags(tokens: list[str]) -> tuple[int, list[str]]:
     return flag, tokens
 
 
-def parse_source(source: Source) -> list[GocadObject]:
-    """Every object (with known type) of a GOCAD file, in file order."""
-    return _Parser(source).parse_all()
+def parse_source(source: Source, skipped: list[str] | None = None) -> list[GocadObject]:
+    """Every object (with known type) of a GOCAD file, in file order.
+
+    ``skipped`` receives one sentence per part of the file that is not read.
+    """
+    parser = _Parser(source)
+    objects = parser.parse_all()
+    if skipped is not None:
+        skipped.extend(parser.skipped)
+    return objects

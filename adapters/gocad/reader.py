@@ -28,6 +28,7 @@ from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.adapters.gocad.parser import GROUP_TYPES, GocadObject, GocadWarning, parse_source
 from geobrep.adapters.gocad.regions import TetFaces, root_vertices
 from geobrep.adapters.gocad.tables import ResolvedVertices
+from geobrep.capabilities import SKIPPED_ON_READ
 from geobrep.crs import CRS
 from geobrep.entities import Entity, PointSet, PolyLine, Surface, TetMesh
 from geobrep.errors import EntityValidationError, FormatError, TopologyError
@@ -121,6 +122,7 @@ class _Builder:
         self.entities: list[Entity] = []
         self.scene_crs: dict[str, Any] | None = None
         self.surface_of_object: dict[int, int] = {}
+        self.skipped: list[str] = []
 
     def error(self, message: str, line: int | None) -> FormatError:
         return FormatError(message, self.path, line)
@@ -469,6 +471,7 @@ class _Builder:
         for surface in model.get("surfaces", []):
             if not surface["tfaces"]:
                 self.warn(f"MODEL surface {surface['name']!r} has no TFACE; skipped", obj.line)
+                self.skipped.append(f"MODEL surface {surface['name']!r} of {obj.name!r}: no TFACE")
                 continue
             self._tsolid_surface(obj, surface, xyz, lookup, tet_id)
 
@@ -684,5 +687,12 @@ def read_gocad(path: Path, options: GocadReadOptions | None = None) -> Scene:
     >>> geobrep.read("modelA4.ml").topology.patches  # doctest: +SKIP
     """
     source = Source.read(Path(path))
-    objects = parse_source(source)
-    return _Builder(source, options or GocadReadOptions()).build(objects)
+    skipped: list[str] = []
+    objects = parse_source(source, skipped)
+    builder = _Builder(source, options or GocadReadOptions())
+    scene = builder.build(objects)
+    skipped.extend(builder.skipped)
+    if not skipped:
+        return scene
+    metadata = {**scene.metadata, SKIPPED_ON_READ: skipped}  # reported as lost by convert
+    return scene.model_copy(update={"metadata": metadata})

@@ -18,6 +18,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters.meshio.bridge import (
@@ -187,10 +188,38 @@ def _surface_writer(file_format: str):  # type: ignore[no-untyped-def]
     return write
 
 
-def _gmsh_write(scene: Scene, path: Path, options: BaseModel) -> None:
-    import numpy as np
+#: Components per value a Gmsh data field may have.
+_GMSH_COMPONENTS = (1, 3, 9)
 
+
+def _components(values: object) -> int:
+    shape = getattr(values, "shape", ())
+    return int(np.prod(shape[1:])) if len(shape) > 1 else 1
+
+
+def _gmsh_losses(scene: Scene, path: Path) -> list[str]:
+    """Gmsh keeps no header: property names lose their whitespace; odd sizes are dropped."""
+    lost = []
+    props = {n: p for e in scene.entities for n, p in e.point_data.items()}
+    renamed = sorted(n for n in props if "_".join(n.split()) != n)
+    if renamed:
+        lost.append(
+            "property names with whitespace read back with '_': "
+            + ", ".join(f"{n!r} as {'_'.join(n.split())!r}" for n in renamed)
+        )
+    odd = sorted(n for n, p in props.items() if _components(p.values) not in _GMSH_COMPONENTS)
+    if odd:
+        lost.append(f"point properties dropped (Gmsh holds 1, 3 or 9 components): {', '.join(odd)}")
+    return lost
+
+
+def _gmsh_write(scene: Scene, path: Path, options: BaseModel) -> None:
     layout = scene_to_layout(restrict_scene(scene, CAPABILITIES["gmsh"]))
+    layout.point_data = {
+        name: values
+        for name, values in layout.point_data.items()
+        if _components(values) in _GMSH_COMPONENTS
+    }
     mesh = mesh_from_layout(layout, field_data=False)
     assert layout.header is not None
     ids = [int(record["id"]) for record in layout.header["entities"]]  # one block per entity
@@ -270,6 +299,7 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
             sniff=_sniff_gmsh,
             options=NoOptions,
             capabilities=CAPABILITIES["gmsh"],
+            losses=_gmsh_losses,
         )
     )
     for name, description, sniff, options in (

@@ -118,8 +118,19 @@ def read_mesh(path: Path, file_format: str) -> Any:
 
 
 def write_mesh(mesh: Any, path: Path, file_format: str, **kwargs: Any) -> None:
-    """``meshio.write`` with failures contained."""
+    """``meshio.write`` with failures contained; a mesh without points is refused.
+
+    meshio (and the VTK legacy reader) cannot read back a file without points, so none is
+    written: the error says there is nothing this format can hold.
+    """
     import meshio
+
+    if len(mesh.points) == 0:
+        raise FormatError(
+            f"nothing to write: the scene has no points or cells a {file_format} file holds "
+            "(a file without points cannot be read back)",
+            path,
+        )
 
     with _contained(path, "write"):
         meshio.write(path, mesh, file_format=file_format, **kwargs)

@@ -67,6 +67,7 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
                 topology=True,
                 crs=True,
                 multiple_entities=True,
+                empty_entities=True,
             ),
         )
     )

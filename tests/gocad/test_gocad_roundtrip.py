@@ -11,12 +11,14 @@ from gocad_files import DATA, FILES, read_quietly, write_quietly
 import geobrep
 from geobrep import CRS, Block, PointSet, PolyLine, Property, Scene, Surface, TetMesh
 from geobrep.adapters.gocad.parser import GocadWarning
+from geobrep.capabilities import without_read_losses
 from geobrep.model import arrays_identical
 
 
 @pytest.mark.parametrize("name", FILES)
 def test_read_write_read_is_identical(name: str, tmp_path: Path) -> None:
-    first = read_quietly(DATA / name)
+    # what the reader skipped (a Voxet, an SGrid) is not in the scene, so not in the written file
+    first = without_read_losses(read_quietly(DATA / name))
     out = write_quietly(first, tmp_path / name)
     second = read_quietly(out)
     assert second == first  # geometry bit for bit, ids, properties, CRS, topology, metadata

@@ -1,0 +1,33 @@
+GOCAD HeterogeneousGroup 1
+HEADER {
+name:grid_and_top
+}
+BEGIN_MEMBERS
+GOCAD Voxet 1
+HEADER {
+name:porosity_grid
+}
+AXIS_O 0 0 0
+AXIS_U 10 0 0
+AXIS_V 0 10 0
+AXIS_W 0 0 5
+AXIS_MIN 0 0 0
+AXIS_MAX 1 1 1
+AXIS_N 3 3 2
+PROPERTY 1 porosity
+PROP_FILE 1 porosity_grid@@
+END
+GOCAD TSurf 1
+HEADER {
+name:top
+}
+TFACE
+VRTX 1 0 0 5
+VRTX 2 10 0 5
+VRTX 3 0 10 5
+VRTX 4 10 10 6
+TRGL 1 2 3
+TRGL 2 4 3
+END
+END_MEMBERS
+END
