@@ -8,8 +8,8 @@ model size, which is too coarse for float64 data (it calls sub-millimetre detail
 touching) and too fine for float32 data far from the origin (half a metre at UTM northings).
 
 Files round every coordinate the same way, so the quantum is measured as the coarsest of these
-descriptions that holds for every coordinate (tried from the coarsest, on a sample first and
-then on all values):
+descriptions that holds for every coordinate (each family's grids nest: they are tried from the
+finest up on a sample, and the coarsest the sample fits is confirmed on all values):
 
 * **float32** — every value is exactly a float32: the float32 spacing at the largest magnitude;
 * **k decimals** — every value is within two float64 ulps (of the largest magnitude) of its
@@ -108,15 +108,29 @@ def measure_precision(coordinates: FloatArray) -> Precision:
     # Decimals finer than 32 float64 ulps of the largest value cannot be told from float64.
     finest = 32.0 * float(np.spacing(largest))
     most = int(np.floor(-np.log10(finest)))
-    candidates = [(*_float32(largest), "float32")]
     slack = 2.0 * float(np.spacing(largest))
-    candidates += [(*_decimals(k, slack), f"{k} decimals") for k in range(-6, most + 1)]
-    candidates += [
-        (*_digits(largest, d), f"{d} significant digits") for d in range(1, _MAX_DIGITS + 1)
+    # Each family's grids nest (a value on one is on every finer one): from the finest up.
+    families = [
+        [(*_float32(largest), "float32")],
+        [(*_decimals(k, slack), f"{k} decimals") for k in range(most, -7, -1)],
+        [(*_digits(largest, d), f"{d} significant digits") for d in range(_MAX_DIGITS, 0, -1)],
     ]
-    for quantum, holds, source in sorted(candidates, key=lambda c: -c[0]):
-        if quantum > finest and holds(sample) and holds(values):
-            return Precision(quantum, source)
+    found: list[Precision] = []
+    for family in families:
+        grids = [grid for grid in family if grid[0] > finest]
+        fits = 0
+        while fits < len(grids) and grids[fits][1](sample):
+            fits += 1
+        best = max((p.quantum for p in found), default=0.0)
+        if fits and grids[fits - 1][0] <= best:
+            continue  # cannot be coarser than what another family confirmed
+        while fits > 0 and not grids[fits - 1][1](values):
+            fits -= 1
+        if fits:
+            quantum, _, source = grids[fits - 1]
+            found.append(Precision(quantum, source))
+    if found:
+        return max(found, key=lambda p: p.quantum)
     return Precision(float(np.spacing(largest)), "float64")
 
 
