@@ -6,7 +6,9 @@
   (a vertex of one surface lying on a triangle of another). Candidates come from a grid broad
   phase; the narrow phase first drops the pairs a plane keeps apart (:func:`separated`: one
   triangle wholly beyond the other's plane or one of its sides), then tests the six
-  edge–triangle combinations of the others.
+  edge–triangle combinations of the others. Pairs that meet only within :data:`ARC_MARGIN`
+  tolerances of an edge their two surfaces share (a vertex sealed by a sliver beside the line
+  where they meet, moved off it by rounding) are no defect (:func:`_along_shared_lines`).
 * **Gaps**: a vertex on a free border (an edge used by one triangle) lying within
   ``gap_tolerance`` of another surface — not one holding it or its neighbours along the border —
   is a surface that stops just short of the one it should meet.
