@@ -11,6 +11,7 @@ True
 from __future__ import annotations
 
 import os
+import re
 import secrets
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
@@ -134,13 +135,41 @@ def write(
     if not spec.can_write or spec.writer is None:
         raise UnknownFormatError(f"format {spec.name!r} cannot write files", target)
     validated = spec.validate_options(options)
-    with atomic_write(target) as temporary:
-        try:
-            spec.writer(scene, temporary, validated)
-        except GeobrepError:
-            raise
-        except (Exception, SystemExit) as exc:
-            raise FormatError(
-                f"{spec.name} writer failed: {type(exc).__name__}: {exc}", target
-            ) from exc
+    try:
+        with atomic_write(target) as temporary:
+            try:
+                spec.writer(scene, temporary, validated)
+            except GeobrepError:
+                raise
+            except (Exception, SystemExit) as exc:
+                raise FormatError(
+                    f"{spec.name} writer failed: {type(exc).__name__}: {exc}", target
+                ) from exc
+    except GeobrepError as exc:
+        _point_to_target(exc, target)
+        raise
     return target
+
+
+def _point_to_target(error: GeobrepError, target: Path) -> None:
+    """Make an error raised while writing a temporary file name ``target`` instead.
+
+    The writer only sees :func:`atomic_write`'s temporary path (``.out.tmp-1530bb30.vtu``, or
+    ``..out.tmp-….tmp-….vtu`` when the writer writes atomically too), so its messages and
+    ``path`` attributes name it: the user asked for ``out.vtu``.
+    """
+    suffix = "".join(target.suffixes[-1:])
+    temporary = re.compile(
+        r"\.+" + re.escape(target.stem) + r"(?:\.tmp-[0-9a-f]{8})+" + re.escape(suffix)
+    )
+
+    def fixed(value: object) -> object:
+        if isinstance(value, str):
+            return temporary.sub(lambda _: target.name, value)
+        if isinstance(value, Path) and temporary.fullmatch(value.name):
+            return value.with_name(target.name)
+        return value
+
+    error.args = tuple(fixed(arg) for arg in error.args)
+    for name, value in vars(error).items():
+        setattr(error, name, fixed(value))

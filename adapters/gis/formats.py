@@ -354,7 +354,8 @@ def _write_tables(
             warnings.filterwarnings("ignore", message=".*[Nn]ormalized/laundered.*")
             warnings.filterwarnings("ignore", message=".*truncated.*")
             warnings.filterwarnings("ignore", message=".*'crs' was not provided.*")
-            pyogrio.raw.write(
+            _raw_write(
+                pyogrio,
                 path,
                 shapely.to_wkb(table.geometry, include_srid=False, output_dimension=3),
                 data,
@@ -368,6 +369,40 @@ def _write_tables(
                 promote_to_multi=False,
                 **kwargs,
             )
+
+
+#: What GDAL's (and SQLite's) messages mean, in words; the first that matches is said.
+_WRITE_FAILURES = (
+    (("readonly database", "read-only", "read only"), "the file or its folder is read-only"),
+    (("disk is full", "no space left"), "the disk is full"),
+    (("database is locked",), "the file is locked by another program"),
+    (("disk i/o error", "input/output error"), "the disk reported an input/output error"),
+    (
+        ("unable to open database", "no such file", "permission denied", "failed to create"),
+        "the file cannot be created in its folder (is the folder writable?)",
+    ),
+)
+_DRIVER_NAMES = {"GPKG": "GeoPackage", "GeoJSON": "GeoJSON", "ESRI Shapefile": "shapefile"}
+
+
+def _raw_write(pyogrio: Any, path: Path, *args: Any, **kwargs: Any) -> None:
+    """``pyogrio.raw.write``; a GDAL/SQLite failure is a FormatError saying what happened."""
+    try:
+        pyogrio.raw.write(path, *args, **kwargs)
+    except Exception as exc:
+        if not type(exc).__module__.startswith("pyogrio"):
+            raise
+        text = str(exc)
+        kind = _DRIVER_NAMES.get(kwargs.get("driver", ""), "GIS")
+        for needles, words in _WRITE_FAILURES:
+            if any(needle in text.lower() for needle in needles):
+                raise FormatError(f"cannot write the {kind} file: {words}", path) from exc
+        detail = re.sub(r"sqlite3_\w+\([^)]*\)\s*(failed:?)?\s*", "", text).strip()
+        raise FormatError(
+            f"cannot write layer {kwargs.get('layer')!r} of the {kind} file: "
+            f"{detail or type(exc).__name__}",
+            path,
+        ) from exc
 
 
 def _shapefile_write(table: FeatureTable, path: Path, crs: CRS | None) -> None:

@@ -12,9 +12,10 @@ import json
 from pathlib import Path
 from typing import Any
 
+from geobrep.cli.common import add_allow_empty, format_name, read_input
 from geobrep.entities import Block, Entity
 from geobrep.errors import OptionsError
-from geobrep.io import read, write
+from geobrep.io import write
 from geobrep.scene import Group, Scene
 
 __all__ = ["add_parser", "describe", "merge_scenes", "run"]
@@ -31,8 +32,14 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("inputs", nargs="+", metavar="IN", help="input files (e.g. several .ts)")
     parser.add_argument("output", metavar="OUT", help="output file (e.g. .geobrep or .ml)")
-    parser.add_argument("--format", help="output format name, when the extension is not enough")
-    parser.add_argument("--input-format", help="input format name for every input file")
+    parser.add_argument(
+        "--format",
+        type=format_name("write"),
+        help="output format name, when the extension is not enough",
+    )
+    parser.add_argument(
+        "--input-format", type=format_name("read"), help="input format name for every input file"
+    )
     parser.add_argument(
         "--tolerance",
         type=float,
@@ -64,6 +71,7 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("--report", metavar="FILE", help="also write the report as JSON here")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
+    add_allow_empty(parser)
     parser.set_defaults(run=run)
 
 
@@ -130,7 +138,7 @@ def run(args: argparse.Namespace) -> int:
     from geobrep.io import atomic_write
 
     sources = [str(path) for path in args.inputs]
-    scenes = [read(path, format=args.input_format) for path in sources]
+    scenes = [read_input(args, path, format=args.input_format) for path in sources]
     scene = merge_scenes(scenes, sources)
     built = build_blocks(scene, **_options(args))
     target = write(built, args.output, format=args.format)

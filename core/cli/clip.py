@@ -12,10 +12,26 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from geobrep.cli.common import (
+    add_allow_empty,
+    format_name,
+    is_empty,
+    read_input,
+    refuse_empty,
+    warn,
+)
 from geobrep.errors import OptionsError
 from geobrep.geometry import Plane
 
-__all__ = ["add_parser", "add_plane_arguments", "both_paths", "plane_from_args", "run"]
+__all__ = [
+    "add_parser",
+    "add_plane_arguments",
+    "both_paths",
+    "plane_from_args",
+    "plane_text",
+    "run",
+    "span_text",
+]
 
 
 def _numbers(text: str, count: int, flag: str) -> list[float]:
@@ -54,6 +70,40 @@ def plane_from_args(args: argparse.Namespace) -> Plane | None:
     return None
 
 
+def plane_text(args: argparse.Namespace) -> str:
+    """The plane or box as the user gave it, for messages: ``the plane x = 1e+09``."""
+    if args.plane is not None:
+        return f"the plane {args.plane} (a,b,c,d)"
+    for axis in ("x", "y", "z"):
+        value = getattr(args, axis)
+        if value is not None:
+            return f"the plane {axis} = {value:g}"
+    return f"the box {getattr(args, 'box', '')}"
+
+
+def span_text(scene: Any) -> str:
+    """Where the model is, for messages: ``the model spans x -5291 … 10949, y …, z …``."""
+    bounds = scene.bounds
+    if bounds is None:
+        return "the model has no geometry"
+    xmin, xmax, ymin, ymax, zmin, zmax = bounds.as_tuple()
+    return (
+        f"the model spans x {xmin:.6g} … {xmax:.6g}, y {ymin:.6g} … {ymax:.6g}, "
+        f"z {zmin:.6g} … {zmax:.6g}"
+    )
+
+
+def _misses(plane: Plane, scene: Any) -> bool:
+    """True when the model's bounding box lies wholly on one side of ``plane``."""
+    bounds = scene.bounds
+    if bounds is None:
+        return False
+    xmin, xmax, ymin, ymax, zmin, zmax = bounds.as_tuple()
+    corners = [(x, y, z) for x in (xmin, xmax) for y in (ymin, ymax) for z in (zmin, zmax)]
+    sides = plane.signed_distance(corners)
+    return bool((sides > 0).all() or (sides < 0).all())
+
+
 def both_paths(output: Path) -> tuple[Path, Path]:
     """Where ``--keep both`` writes: ``NAME-negative.EXT`` and ``NAME-positive.EXT``.
 
@@ -85,8 +135,11 @@ def add_parser(subparsers: Any) -> None:
         help="side to keep: negative (a·x+b·y+c·z+d < 0, the default), positive, or both",
     )
     parser.add_argument("--tolerance", type=float, help="on-plane distance (model units)")
-    parser.add_argument("--format", help="input format name, when the extension is not enough")
-    parser.add_argument("--output-format", help="output format name")
+    parser.add_argument(
+        "--format", type=format_name("read"), help="input format, when the extension is not enough"
+    )
+    parser.add_argument("--output-format", type=format_name("write"), help="output format name")
+    add_allow_empty(parser)
     parser.set_defaults(run=run)
 
 
@@ -100,26 +153,39 @@ def _describe(scene: Any) -> str:
 
 def run(args: argparse.Namespace) -> int:
     from geobrep.clipping import clip, clip_box
-    from geobrep.io import as_scene, read, write
+    from geobrep.io import as_scene, write
 
-    scene = read(args.input, format=args.format)
+    scene = read_input(args, args.input, format=args.format)
     output = Path(args.output)
     plane = plane_from_args(args)
+    results: list[tuple[Path, Any, str]] = []
     if plane is None:
         if args.keep != "negative":
             raise OptionsError("--box keeps the inside of the box: --keep does not apply")
         result = clip_box(scene, _numbers(args.box, 6, "--box"), tolerance=args.tolerance)
-        kept = as_scene(result if result is not None else [])
-        write(kept, output, format=args.output_format)
-        print(f"{output}: {_describe(kept)}")
-        return 0
-    if args.keep == "both":
+        results.append((output, as_scene(result if result is not None else []), "inside of"))
+    elif args.keep == "both":
         negative, positive = clip(scene, plane, keep="both", tolerance=args.tolerance)
-        for path, part in zip(both_paths(output), (negative, positive), strict=True):
-            write(part, path, format=args.output_format)
-            print(f"{path}: {_describe(part)}")
-        return 0
-    kept = clip(scene, plane, keep=args.keep, tolerance=args.tolerance)
-    write(kept, output, format=args.output_format)
-    print(f"{output}: {_describe(kept)}")
+        for path, part, side in zip(
+            both_paths(output), (negative, positive), ("negative", "positive"), strict=True
+        ):
+            results.append((path, part, f"{side} side of"))
+    else:
+        kept = clip(scene, plane, keep=args.keep, tolerance=args.tolerance)
+        results.append((output, kept, f"{args.keep} side of"))
+    where = f"{plane_text(args)} ({span_text(scene)})"
+    refuse_empty(
+        args,
+        [
+            f"{path}: nothing on the {side} {where}"
+            for path, part, side in results
+            if is_empty(part)
+        ],
+        consequence="no file written",
+    )
+    if plane is not None and args.keep != "both" and _misses(plane, scene):
+        warn(f"{output}: {plane_text(args)} does not meet the model ({span_text(scene)})")
+    for path, part, _ in results:
+        write(part, path, format=args.output_format)
+        print(f"{path}: {_describe(part)}")
     return 0

@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 from typing import Any, Protocol
 
+from geobrep.cli.common import add_allow_empty, format_name, refuse_empty
 from geobrep.conversion import ConversionSummary, convert
 from geobrep.errors import OptionsError
 
@@ -34,7 +35,12 @@ def add_parser(subparsers: Any) -> None:
         metavar="PATH",
         help="input file(s) or glob(s), then the output file when converting one file without --to",
     )
-    parser.add_argument("--to", metavar="FMT", help="target format name or extension (many files)")
+    parser.add_argument(
+        "--to",
+        type=format_name("write"),
+        metavar="FMT",
+        help="target format name or extension (many files)",
+    )
     parser.add_argument("-o", "--output-dir", metavar="DIR", help="output folder (many files)")
     parser.add_argument(
         "--jobs",
@@ -50,6 +56,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument(
         "--format",
         dest="read_format",
+        type=format_name("read"),
         metavar="NAME",
         help="input format, when the extension is not enough",
     )
@@ -60,6 +67,7 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the reports as JSON")
+    add_allow_empty(parser)
     parser.set_defaults(run=run)
 
 
@@ -114,7 +122,13 @@ def run(args: argparse.Namespace) -> int:
         verify=args.verify,
     )
     _print(summary, args.json)
-    return 0 if summary.ok else 1
+    if not summary.ok:
+        return 1
+    empty = [
+        f"{r.target}: nothing read from {r.source}" for r in summary.converted if not r.entities
+    ]
+    refuse_empty(args, empty, consequence="the file holds nothing")
+    return 0
 
 
 def _print(summary: ConversionSummary, as_json: bool) -> None:

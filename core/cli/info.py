@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 from typing import Any
 
+from geobrep.cli.common import add_allow_empty, format_name, is_empty, refuse_empty
+from geobrep.crs import CRS
 from geobrep.entities import (
     Block,
     Entity,
@@ -29,8 +32,11 @@ def add_parser(subparsers: Any) -> None:
         "info", help="describe a file", description="Describe the entities of a file."
     )
     parser.add_argument("file", help="file to describe (any readable format)")
-    parser.add_argument("--format", help="format name, when the extension is not enough")
+    parser.add_argument(
+        "--format", type=format_name("read"), help="format name, when the extension is not enough"
+    )
     parser.add_argument("--json", action="store_true", help="print JSON for machines")
+    add_allow_empty(parser)
     parser.set_defaults(run=run)
 
 
@@ -87,8 +93,35 @@ def describe_entity(entity: Entity) -> dict[str, Any]:
     }
 
 
+#: CRS names GOCAD and SKUA give a model built in local coordinates (``Default``, ``SKUA Local``,
+#: ``gocad Local``, ...): no projection, no datum.
+_LOCAL_NAME = re.compile(r"\s*(default|.*\blocal)\s*", re.IGNORECASE)
+
+
+def local_crs(crs: CRS) -> bool:
+    """True for a local engineering CRS: only a name such as ``Default`` or ``SKUA Local``.
+
+    A GOCAD header with ``PROJECTION Unknown`` and ``DATUM Unknown`` says the same of any name.
+
+    >>> local_crs(CRS(name="SKUA Local")), local_crs(CRS(epsg=32631))
+    (True, False)
+    """
+    if crs.epsg is not None or crs.wkt or crs.proj:
+        return False
+    gocad = crs.metadata.get("gocad")
+    unknown = isinstance(gocad, dict) and all(
+        str(gocad.get(key, "Unknown")).strip().lower() in ("unknown", "none", "")
+        for key in ("projection", "datum")
+    )
+    return bool(unknown or (crs.name and _LOCAL_NAME.fullmatch(crs.name)))
+
+
 def _parsed_crs(scene: Scene) -> dict[str, Any] | None:
-    """What pyproj reads in the scene's CRS (name, units, vertical datum), when it is there."""
+    """What pyproj reads in the scene's CRS (name, units, vertical datum), when it is there.
+
+    A local engineering CRS (GOCAD's ``Default``, ``SKUA Local``) that pyproj cannot read is
+    described as such (``"local": True``), not as a failure.
+    """
     if scene.crs is None:
         return None
     try:
@@ -100,6 +133,13 @@ def _parsed_crs(scene: Scene) -> dict[str, Any] | None:
     except ImportError:  # pyproj (the gis extra) is not installed
         return None
     except GeobrepError as exc:
+        if local_crs(scene.crs):
+            return {
+                "name": scene.crs.name,
+                "type": "local engineering CRS",
+                "local": True,
+                "units": list(scene.crs.axis_units),
+            }
         return {"error": str(exc)}
 
 
@@ -170,6 +210,9 @@ def _parsed_crs_lines(parsed: dict[str, Any] | None) -> list[str]:
         return []
     if "error" in parsed:
         return [f"          not understood by pyproj: {parsed['error']}"]
+    if parsed.get("local"):
+        name = str(parsed["name"]).strip()
+        return [f"          local (engineering) CRS {name!r}, not georeferenced"]
     datum = parsed.get("vertical_datum") or "none given"
     return [
         f"          {parsed['name']} ({parsed['type']}; units {', '.join(parsed['units'])}; "
@@ -184,4 +227,8 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps({"file": args.file, **summary}, indent=2))
     else:
         print(render_text(summary, args.file))
+    if is_empty(scene):
+        count = len(scene.entities)
+        what = f"{count} entities, none with geometry" if count else "no entities"
+        refuse_empty(args, [f"{args.file}: nothing read ({what})"])
     return 0

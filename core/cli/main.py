@@ -10,6 +10,7 @@ import traceback
 from collections.abc import Sequence
 from types import ModuleType
 
+from geobrep.cli.common import EXIT_EMPTY, CliParser, EmptyResultError, WarningLines, add_verbosity
 from geobrep.errors import GeobrepError
 
 __all__ = ["build_parser", "main"]
@@ -41,27 +42,46 @@ def build_parser() -> argparse.ArgumentParser:
     """The top-level parser with one subparser per command module."""
     from geobrep import __version__
 
-    parser = argparse.ArgumentParser(
+    parser = CliParser(
         prog="geobrep",
         description="Typed B-Rep scene graph for 3D geological structural models.",
     )
     parser.add_argument("--version", action="version", version=f"geobrep {__version__}")
+    add_verbosity(parser, top_level=True)
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for command in _command_modules():
         command.add_parser(subparsers)
+    for subparser in {id(p): p for p in subparsers.choices.values()}.values():
+        add_verbosity(subparser)
     return parser
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit code (also used by the console script)."""
+    """Run the command line; returns the exit code (also used by the console script).
+
+    Warnings raised meanwhile are printed as short ``warning:`` lines (see
+    :class:`~geobrep.cli.common.WarningLines`), after the command's output and before its error.
+    """
+    with WarningLines() as lines:
+        return _run(argv, lines)
+
+
+def _run(argv: Sequence[str] | None, lines: WarningLines) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse: --help/--version (0) or a usage error (2)
         return int(exc.code or 0)
+    lines.set_verbosity(args.verbosity)
     try:
         return int(args.run(args))
+    except EmptyResultError as exc:
+        lines.flush()
+        for message in exc.messages:
+            print(f"warning: {message}", file=sys.stderr)
+        return EXIT_EMPTY
     except GeobrepError as exc:
+        lines.flush()
         print(f"geobrep: error: {exc}", file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:
@@ -70,6 +90,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:
         return EXIT_OK
     except Exception as exc:
+        lines.flush()
         if os.environ.get("GEOBREP_TRACEBACK"):
             traceback.print_exc()
         print(

@@ -9,8 +9,9 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from geobrep.cli.common import add_allow_empty, format_name, read_input
 from geobrep.errors import OptionsError
-from geobrep.io import read, write
+from geobrep.io import write
 
 __all__ = ["add_parser", "run"]
 
@@ -33,7 +34,9 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("scene", help="model file (any readable format)")
     parser.add_argument("output", help="picture to write (.png)")
-    parser.add_argument("--format", help="input format, when the extension is not enough")
+    parser.add_argument(
+        "--format", type=format_name("read"), help="input format, when the extension is not enough"
+    )
     parser.add_argument(
         "--color-by",
         choices=("entity", "block", "property"),
@@ -61,6 +64,7 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("--edges", action="store_true", help="draw triangle edges")
     parser.add_argument("--vertical-exaggeration", type=float, default=1.0, metavar="F")
+    add_allow_empty(parser)
     parser.set_defaults(run=run)
 
 
@@ -68,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     if (args.clip_origin is None) != (args.clip_normal is None):
         raise OptionsError("--clip-origin and --clip-normal go together")
     color_by = args.color_by or ("property" if args.property else "entity")
-    scene = read(args.scene, format=args.format)
+    scene = read_input(args, args.scene, format=args.format)
     path = write(
         scene,
         args.output,

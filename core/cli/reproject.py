@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from geobrep.cli.common import add_allow_empty, format_name, read_input
+
 __all__ = ["add_parser", "run"]
 
 
@@ -26,16 +28,19 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument(
         "--from", dest="source", help="source CRS, when the file has none (or to override it)"
     )
-    parser.add_argument("--format", help="input format name, when the extension is not enough")
-    parser.add_argument("--to-format", help="output format name")
+    parser.add_argument(
+        "--format", type=format_name("read"), help="input format, when the extension is not enough"
+    )
+    parser.add_argument("--to-format", type=format_name("write"), help="output format name")
+    add_allow_empty(parser)
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from geobrep.crs_ops import to_crs
-    from geobrep.io import read, write
+    from geobrep.io import write
 
-    scene = read(args.input, format=args.format)
+    scene = read_input(args, args.input, format=args.format)
     moved = to_crs(scene, args.target, source=args.source)
     write(moved, args.output, format=args.to_format)
     source = args.source or (scene.crs.label if scene.crs else "?")

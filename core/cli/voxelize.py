@@ -5,8 +5,15 @@ from __future__ import annotations
 import argparse
 import json
 import time
-import warnings
 from typing import Any
+
+from geobrep.cli.common import (
+    add_allow_empty,
+    format_name,
+    read_input,
+    recorded_warnings,
+    refuse_empty,
+)
 
 __all__ = ["add_parser", "run"]
 
@@ -65,21 +72,23 @@ def add_parser(subparsers: Any) -> None:
         "--block-depth", type=int, help="process 8**N sub-cubes one at a time (default depth-8)"
     )
     parser.add_argument("--keep-input", action="store_true", help="also write the input model")
-    parser.add_argument("--format", help="input format name, when the extension is not enough")
-    parser.add_argument("--output-format", help="output format name")
+    parser.add_argument(
+        "--format", type=format_name("read"), help="input format, when the extension is not enough"
+    )
+    parser.add_argument("--output-format", type=format_name("write"), help="output format name")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
+    add_allow_empty(parser)
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from geobrep.io import read, write
+    from geobrep.io import write
     from geobrep.scene import Scene
-    from geobrep.voxelization import VoxelizationWarning, voxelize
+    from geobrep.voxelization import voxelize
 
-    scene = read(args.input, format=args.format)
+    scene = read_input(args, args.input, format=args.format)
     start = time.perf_counter()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", VoxelizationWarning)
+    with recorded_warnings() as caught:
         tree = voxelize(
             scene,
             depth=args.depth,
@@ -91,6 +100,8 @@ def run(args: argparse.Namespace) -> int:
             block_depth=args.block_depth,
         )
     elapsed = time.perf_counter() - start
+    if tree.n_leaves == 0:
+        refuse_empty(args, [f"{args.output}: the octree has no leaf"], consequence="not written")
     result = (
         scene.with_entities(tree)
         if args.keep_input
@@ -141,6 +152,4 @@ def run(args: argparse.Namespace) -> int:
         f"  memory: {tree.memory_bytes:,} bytes vs {full_grid:,} for a full grid "
         f"of one byte per cell ({tree.memory_bytes / full_grid:.1%})"
     )
-    for message in summary["warnings"]:
-        print(f"  warning: {message}")
     return 0
