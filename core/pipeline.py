@@ -640,7 +640,7 @@ def option_names(step_type: type[StepOptions]) -> list[str]:
     """The keys a step body takes (aliases where a field has one), in declaration order.
 
     >>> option_names(FitStep)
-    ['method', 'points', 'options', 'keep_input', 'check']
+    ['method', 'points', 'options', 'keep_input', 'check', 'max_triangles']
     """
     return [info.alias or name for name, info in step_type.model_fields.items()]
 
