@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict
 
-from geobrep.capabilities import capability_losses
+from geobrep.capabilities import format_losses
 from geobrep.conversion import expand, report_table, run_each
 from geobrep.entities import Entity, NurbsSurface, PointSet, PolyLine, Surface
 from geobrep.errors import (
@@ -472,12 +472,13 @@ def _voxelize(step: VoxelizeStep, scene: Scene, work: _Work) -> Applied:
 def _write(step: WriteStep, scene: Scene, work: _Work) -> Applied:
     target = work.targets[len(work.pending)]
     format_name = step.format_name(work.registries)
-    caps = work.registries.formats.get(format_name).capabilities
+    spec = work.registries.formats.get(format_name)
+    caps = spec.capabilities
     held = caps.entity_types
     meshes: list[str] = []
     if step.tessellate and held and "NurbsSurface" not in held and "Surface" in held:
         scene, meshes = _tessellated(scene, work, target)
-    losses = [f"{target.name}: {loss}" for loss in capability_losses(scene, caps)]
+    losses = [f"{target.name}: {loss}" for loss in format_losses(scene, spec, target)]
     work.lost.extend(losses)
     work.pending.append((work.number, step.kind, target, scene, format_name, dict(step.options)))
     return scene, [*meshes, *(losses or [f"{target.name}: nothing lost"])]

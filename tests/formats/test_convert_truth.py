@@ -291,6 +291,24 @@ def test_cli_convert_verify(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
     assert "5 Block entities dropped" in out
 
 
+def test_a_pipeline_reports_what_its_reader_skipped_and_its_target_drops(tmp_path: Path) -> None:
+    from geobrep.pipeline_run import run_pipeline
+
+    pipeline = {
+        "version": 1,
+        "inputs": [str(GOCAD / "voxet_and_tsurf.gp"), str(GOCAD / "split_cube.ml")],
+        "output": str(tmp_path),
+        "steps": [{"read": {}}, {"write": {"format": "gocad", "name": "{stem}.ts"}}],
+    }
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        summary = run_pipeline(pipeline)
+    assert summary.ok, summary
+    voxet, cube = (report.lost for report in summary.reports)
+    assert "skipped on read: GOCAD Voxet 'porosity_grid'" in " ".join(voxet)
+    assert any("3 Block entities dropped (a GOCAD TSurf file" in s for s in cube), cube
+
+
 if __name__ == "__main__":  # a measurement: python tests/formats/test_convert_truth.py
     import sys
     import tempfile
