@@ -45,7 +45,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from geobrep.entities import Surface
-from geobrep.errors import TopologyError
+from geobrep.errors import DegenerateGeometryError, TopologyError
 from geobrep.geometry import mesh
 from geobrep.geometry.bbox import column_extremes
 from geobrep.scene import Scene
@@ -426,6 +426,36 @@ def _patch_triangles(
     return vertices, triangles.astype(np.int64), owners
 
 
+def _around(
+    chains: ArcChains,
+    arc: int,
+    points: NDArray[np.float64],
+    tri: IntArray,
+    offsets: IntArray,
+    incident: IntArray,
+    sides: IntArray,
+    incident_patch: IntArray,
+) -> IntArray:
+    """Patches of the triangles at arc ``arc``, in right-hand order about its first edge
+    whose triangles all leave it at an angle (a clip may leave slivers on some)."""
+    lo, hi = int(chains.arc_offsets[arc]), int(chains.arc_offsets[arc + 1])
+    members = incident_patch[offsets[chains.edge_ids[lo]] : offsets[chains.edge_ids[lo] + 1]]
+    if members.shape[0] < 2:
+        return members
+    for k in range(lo, hi):
+        edge = int(chains.edge_ids[k])
+        around = slice(int(offsets[edge]), int(offsets[edge + 1]))
+        thirds = tri[incident[around], (sides[around] + 2) % 3]
+        origin = points[int(chains.edge_start[k])]
+        axis = points[int(chains.edge_end[k])] - origin
+        try:
+            order = mesh.sort_around_axis(origin, axis, points[thirds] - origin)
+        except DegenerateGeometryError:
+            continue
+        return incident_patch[around][order]
+    return members
+
+
 def corners_and_arcs(
     surfaces: Mapping[int, Surface],
     patches: Sequence[Patch],
@@ -480,17 +510,7 @@ def corners_and_arcs(
     arcs: list[Arc] = []
     patch_arcs: dict[int, list[int]] = {}
     for a in range(chains.n_arcs):
-        first = int(chains.arc_offsets[a])
-        edge = int(chains.edge_ids[first])
-        p0, p1 = int(chains.edge_start[first]), int(chains.edge_end[first])
-        around = slice(int(offsets[edge]), int(offsets[edge + 1]))
-        members = incident_patch[around]
-        thirds = tri[incident[around], (sides[around] + 2) % 3]
-        if members.shape[0] > 1:
-            origin = merged[p0]
-            members = members[
-                mesh.sort_around_axis(origin, merged[p1] - origin, merged[thirds] - origin)
-            ]
+        members = _around(chains, a, merged, tri, offsets, incident, sides, incident_patch)
         patch_ids = tuple(int(patches[int(m)].id) for m in members.tolist())
         chain = chains.chain_vertices[chains.chain_offsets[a] : chains.chain_offsets[a + 1]]
         arcs.append(
