@@ -291,7 +291,8 @@ def _groups(
                     entry["line"],
                 )
             members = [region_block[i] for i in items if i in region_block]
-            raw = {"keyword": keyword, "regions": items}
+            # "unmatched": ids the file itself lists without a REGION (kept when written)
+            raw = {"keyword": keyword, "regions": items, "unmatched": unknown}
         else:
             members = list(
                 dict.fromkeys(surface_of_tface[i] for i in items if i in surface_of_tface)

@@ -172,6 +172,20 @@ def test_clipped_real_model_lists_only_written_regions() -> None:
         _assert_same(half, back, build_corners_and_arcs(half))
 
 
+def test_clipped_layers_list_only_the_regions_written() -> None:
+    """modelA4's LAYERs name the REGIONs of blocks a clip drops; its own FAULT_BLOCK lists
+    ids 65-67 that match no REGION in the source: those stay, as the file had them."""
+    scene = read_quietly(DATA / "modelA4.ml")
+    box = scene.bounds
+    assert box is not None
+    plane = geobrep.Plane.x(0.5 * (box.mins[0] + box.maxs[0]))
+    for half in _halves(scene, plane):
+        back, messages = _round_trip(half)
+        unmatched = [m for m in messages if "does not match a REGION" in m]
+        assert all("FAULT_BLOCK 'no_fault_block_name': id 65" in m for m in unmatched)
+        assert len(back.blocks) == len(half.blocks)
+
+
 @pytest.mark.parametrize("name", ["modelA1.ml", "modelA4.ml"])
 def test_rebuilt_blocks(name: str) -> None:
     scene = read_quietly(DATA / name)
