@@ -10,8 +10,9 @@ After the surfaces of a scene are cut, each half keeps:
   closed by a **cap** patch (registered by the Block clipper) between it and the universe. The
   caps of a half form one new Surface, ``kind="cap"``, one patch label per block, so neighbouring
   blocks' caps share their edges;
-* the **arcs** cut to their parts on that side (new corners where they cross the plane), and the
-  **groups** without the entities that are gone, plus a ``caps`` group.
+* **corners and arcs** rebuilt from the half's patches by the one rule of :mod:`geobrep.arcs`
+  (the caps' borders included), and the **groups** without the entities that are gone, plus a
+  ``caps`` group.
 """
 
 from __future__ import annotations
@@ -22,11 +23,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.entities import Block, Entity, PatchSide, PolyLine, Surface
-from geobrep.errors import TopologyError
+from geobrep.arcs import build_corners_and_arcs
+from geobrep.entities import Block, Entity, PatchSide, Surface
 from geobrep.geometry import Plane, boxes_plane_side, mesh
 from geobrep.scene import Group, Scene
-from geobrep.topology import Arc, Corner, Patch, Topology
+from geobrep.topology import Patch, Topology
 
 if TYPE_CHECKING:
     from geobrep.clipping import ClipContext, Keep, SceneDraft
@@ -211,11 +212,7 @@ def _assemble(
         )
         for pid, p in patches.items()
     }
-    arcs, corners, arc_map = _carry_arcs(scene, plane, side, context, registry)
-    fixed = {
-        pid: p.model_copy(update={"arcs": tuple(a for old in p.arcs for a in arc_map.get(old, ()))})
-        for pid, p in fixed.items()
-    }
+    fixed = {pid: p.model_copy(update={"arcs": ()}) for pid, p in fixed.items()}
     entities: list[Entity] = []
     for entity in scene.entities:
         ident = int(entity.id or 0)
@@ -232,18 +229,18 @@ def _assemble(
     groups = tuple(_prune(group, present) for group in scene.groups)
     if cap_surface is not None:
         groups = (*groups, Group(name="caps", kind="caps", members=(cap_id,)))
-    arcs = [
-        a.model_copy(update={"patches": tuple(p for p in a.patches if p in fixed)}) for a in arcs
-    ]
-    topology = Topology(corners=tuple(corners), arcs=tuple(arcs), patches=tuple(fixed.values()))
-    return Scene(
+    half = Scene(
         entities=entities,
         groups=groups,
         crs=scene.crs,
-        topology=topology,
+        topology=Topology(patches=tuple(fixed.values())),
         name=scene.name,
         metadata=scene.metadata,
     )
+    if not scene.topology.arcs:
+        return half
+    # Corners and arcs follow the one rule of geobrep.arcs, as if the half had been read.
+    return half.replace(topology=build_corners_and_arcs(half))
 
 
 def _with_sides(block: Block, patches: dict[int, Patch]) -> Block:
@@ -323,55 +320,3 @@ def _caps(
         for position, (ident, _) in enumerate(caps)
     ]
     return surface, patches
-
-
-# ------------------------------------------------------------------------------- arcs
-def _carry_arcs(
-    scene: Scene, plane: Plane, side: int, context: ClipContext, registry: ClipperRegistry
-) -> tuple[list[Arc], list[Corner], dict[int, tuple[int, ...]]]:
-    """Arcs cut to their parts on ``side``; new corners where they leave through the plane."""
-    from geobrep.clipping import clip_entity
-
-    topology = scene.topology
-    if not topology.arcs:
-        return [], list(topology.corners), {}
-    keep = "negative" if side < 0 else "positive"
-    next_arc = max(a.id for a in topology.arcs) + 1
-    next_corner = max((c.id for c in topology.corners), default=-1) + 1
-    corners: dict[int, Corner] = {}
-    arcs: list[Arc] = []
-    arc_map: dict[int, tuple[int, ...]] = {}
-    for arc in topology.arcs:
-        line = PolyLine.from_point_lists([arc.points])
-        cut = clip_entity(line, plane, keep, context)  # type: ignore[arg-type]
-        if cut is None:
-            continue
-        if not isinstance(cut, PolyLine):
-            raise TopologyError(f"arc {arc.id}: the PolyLine clipper returned {type(cut).__name__}")
-        pieces: list[int] = []
-        first, last = arc.points[0], arc.points[-1]
-        for part in range(cut.n_parts):
-            points = cut.part(part)
-            ends: list[int | None] = []
-            for point in (points[0], points[-1]):
-                if np.array_equal(point, first) or np.array_equal(point, last):
-                    corner_id = arc.start if np.array_equal(point, first) else arc.end
-                    if corner_id is not None:
-                        corners[corner_id] = topology.corner(corner_id)
-                    ends.append(corner_id)
-                else:
-                    corners[next_corner] = Corner(id=next_corner, point=point)
-                    ends.append(next_corner)
-                    next_corner += 1
-            ident = arc.id if not pieces else next_arc
-            if pieces:
-                next_arc += 1
-            arcs.append(
-                Arc(id=ident, points=points, start=ends[0], end=ends[1], patches=arc.patches)
-            )
-            pieces.append(ident)
-        arc_map[arc.id] = tuple(pieces)
-    for corner in topology.corners:
-        if corner.id not in corners and plane.side(corner.point, context.tolerance)[0] in (0, side):
-            corners[corner.id] = corner
-    return arcs, sorted(corners.values(), key=lambda c: c.id), arc_map
