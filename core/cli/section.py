@@ -28,6 +28,15 @@ def add_parser(subparsers: Any) -> None:
         "--format", type=format_name("read"), help="input format, when the extension is not enough"
     )
     parser.add_argument("--output-format", type=format_name("write"), help="output format name")
+    parser.add_argument(
+        "--coordinates",
+        choices=("auto", "world", "plane", "both"),
+        default="auto",
+        help="where the section of a plane that is not horizontal goes: 'world' (map "
+        "coordinates: a vertical section has no area in map view), 'plane' (distance along the "
+        "section line and elevation, in *_plane layers: valid polygons a GIS can draw), 'both'; "
+        "'auto' (default): both for a GeoPackage, world otherwise",
+    )
     add_allow_empty(parser)
     parser.set_defaults(run=run)
 
@@ -44,7 +53,44 @@ def run(args: argparse.Namespace) -> int:
     if is_empty(panel):
         message = f"{args.output}: {plane_text(args)} touches nothing ({span_text(scene)})"
         refuse_empty(args, [message], consequence="no file written")
-    write(panel, Path(args.output), format=args.output_format)
     polygons = sum(1 for e in panel.entities if e.kind == "section")
-    print(f"{args.output}: {polygons} block sections, {len(panel.entities) - polygons} traces")
+    traces = len(panel.entities) - polygons
+    panel, in_plane = _in_coordinates(panel, plane, _coordinates(args))
+    write(panel, Path(args.output), format=args.output_format)
+    where = " (also in section-plane coordinates)" if in_plane else ""
+    print(f"{args.output}: {polygons} block sections, {traces} traces{where}")
     return 0
+
+
+def _coordinates(args: argparse.Namespace) -> str:
+    if args.coordinates != "auto":
+        return str(args.coordinates)
+    gpkg = args.output_format == "gpkg" or (
+        args.output_format is None and Path(args.output).suffix.lower() == ".gpkg"
+    )
+    return "both" if gpkg else "world"
+
+
+def _in_coordinates(panel: Any, plane: Any, coordinates: str) -> tuple[Any, bool]:
+    """The panel in world coordinates, the plane's own, or both (layers ``*_plane``)."""
+    import numpy as np
+
+    from geobrep.entities import Polygon
+    from geobrep.map_products import section_frame, to_section_plane
+
+    horizontal = float(np.hypot(plane.normal[0], plane.normal[1])) < 1e-12
+    if coordinates == "world" or horizontal or not panel.entities:
+        return panel, False
+    layered = [
+        e.replace(
+            metadata={
+                **e.metadata,
+                "layer": "sections" if isinstance(e, Polygon) else "section_lines",
+            }
+        )
+        for e in panel.entities
+    ]
+    vertices = np.concatenate([e.vertices for e in layered])
+    moved = to_section_plane(layered, section_frame(plane, vertices))
+    kept = layered if coordinates == "both" else []
+    return panel.replace(entities=[*kept, *moved], topology={}), True

@@ -181,3 +181,24 @@ def test_the_geopandas_bridge_keeps_plane_coordinates_apart() -> None:
     flat = to_geodataframe(plane)
     assert flat.crs is None
     assert flat.geometry.is_valid.all()
+
+
+def test_cli_section_to_geopackage_is_drawable_by_default(tmp_path: Path) -> None:
+    from geobrep.cli import main
+
+    source = tmp_path / "cake.geobrep"
+    geobrep.write(CAKE, source)
+    target = tmp_path / "section.gpkg"
+    assert main(["section", str(source), str(target), "--y", "6700400"]) == 0
+    layers = {str(name) for name, _ in pyogrio.list_layers(target)}
+    assert {"sections", "sections_plane"} <= layers
+    drawn = geopandas.read_file(target, layer="sections_plane")
+    assert drawn.geometry.is_valid.all()
+    world = geobrep.section(CAKE, geobrep.Plane.y(6_700_400.0))
+    assert isinstance(world, geobrep.Scene)
+    true_area = sum(p.area for p in world.polygons)
+    assert float(drawn.geometry.area.sum()) == pytest.approx(true_area, rel=1e-9)
+    world_only = tmp_path / "world.gpkg"
+    args = ["section", str(source), str(world_only), "--y", "6700400", "--coordinates", "world"]
+    assert main(args) == 0
+    assert "sections_plane" not in {str(n) for n, _ in pyogrio.list_layers(world_only)}
