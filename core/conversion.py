@@ -280,8 +280,12 @@ def _targets(
     from geobrep.plugins import registries
 
     formats = registries().formats
-    spec = formats.get(to) if to in formats else formats.choose_writer(Path(f"x.{to}"))
-    extension = spec.extensions[0] if spec.extensions else f".{spec.name}"
+    if to in formats:  # a format name: its first extension
+        spec = formats.get(to)
+        extension = spec.extensions[0] if spec.extensions else f".{spec.name}"
+    else:  # an extension (`ml`, `.vtu`): kept as given, so `ml` writes a Model3d, not a TSurf
+        extension = "." + to.lstrip(".").lower()
+        formats.choose_writer(Path(f"x{extension}"))
     targets: list[Path | None] = []
     seen: set[Path] = set()
     for source in sources:

@@ -353,3 +353,14 @@ def test_no_python_warning_text_on_stderr(tmp_path: Path) -> None:
         assert stray == [], f"{name}: {stray}"
     assert "warning: modelA4.ml:306: FAULT_BLOCK" in results["info"][1]
     assert "more like it; -v shows each" in results["clip"][1]
+
+
+def test_convert_to_an_extension_writes_that_extension(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--to ml`` writes a Model3d (blocks kept), not the gocad format's first extension."""
+    code, _, _ = run(capsys, "convert", MODEL_A1, "--to", "ml", "-o", tmp_path / "out")
+    assert code == 0
+    written = sorted(p.name for p in (tmp_path / "out").iterdir())
+    assert written == ["modelA1.ml"]
+    assert len(geobrep.read(tmp_path / "out" / "modelA1.ml").blocks) == 4
