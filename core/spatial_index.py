@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ctypes
 import threading
 from typing import Any
 
@@ -164,8 +165,8 @@ class SpatialIndex:
         if len(self) == 0:
             return np.zeros(0, dtype=np.int64)
         with self._lock:
-            hits, _ = self._index.intersection_v(lo, hi)
-        return np.sort(np.asarray(hits, dtype=np.int64))
+            hits, _ = _bulk_query(self._index, "intersects", lo, hi)
+        return np.sort(hits)
 
     def intersection_batch(self, mins: ArrayLike, maxs: ArrayLike) -> tuple[IntArray, IntArray]:
         """All (query, id) hits of Q query boxes: ``(query_index (H,), ids (H,))``, sorted.
@@ -180,9 +181,8 @@ class SpatialIndex:
         if len(self) == 0 or lo.shape[0] == 0:
             return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
         with self._lock:
-            hits, counts = self._index.intersection_v(lo, hi)
-        hit_ids = np.asarray(hits, dtype=np.int64)
-        query = np.repeat(np.arange(lo.shape[0], dtype=np.int64), counts.astype(np.int64))
+            hit_ids, counts = _bulk_query(self._index, "intersects", lo, hi)
+        query = np.repeat(np.arange(lo.shape[0], dtype=np.int64), counts)
         order = np.lexsort((hit_ids, query))
         return query[order], hit_ids[order]
 
@@ -235,9 +235,7 @@ class SpatialIndex:
         with self._lock:
             # Non-strict: every box tied with the k-th nearest comes back, so the choice
             # among ties is made below, deterministically, not by the tree traversal.
-            hits, counts = self._index.nearest_v(pts, pts, num_results=k)
-        hit_ids = np.asarray(hits, dtype=np.int64)
-        counts64 = counts.astype(np.int64)
+            hit_ids, counts64 = _bulk_query(self._index, "nearest", pts, pts, k)
         if (counts64 < k).any():
             raise RuntimeError(f"rtree returned fewer than k={k} neighbours for some points")
         query = np.repeat(np.arange(pts.shape[0], dtype=np.int64), counts64)
@@ -249,6 +247,64 @@ class SpatialIndex:
         starts = np.concatenate(([0], np.cumsum(counts64)[:-1]))
         rank = np.arange(order.shape[0], dtype=np.int64) - np.repeat(starts, counts64)
         return np.asarray(hit_ids[order][rank < k].reshape(pts.shape[0], k), dtype=np.int64)
+
+
+def _bulk_query(
+    index: Any, kind: str, lo: FloatArray, hi: FloatArray, k: int = 0
+) -> tuple[IntArray, IntArray]:
+    """Hit ids (H,) and hits per query (Q,) of Q boxes: libspatialindex's batch call, in full.
+
+    ``kind`` is ``"intersects"`` or ``"nearest"`` (``k`` neighbours, ties kept). This is what
+    rtree's ``Index.intersection_v`` / ``nearest_v`` do, except for the growth of the id buffer:
+    rtree 1.4.1 computes the new size as ``2 * len(ids) + counts[i]``, a float under numpy < 2
+    (Python int + uint64), which ``ndarray.resize`` rejects as soon as the hits outgrow the first
+    buffer (``TypeError: expected a sequence of integers ... got '812.0'``). Sizes here are ints.
+    The C function fills whole queries in order while they fit and reports how many it finished
+    (``done``) and the hit count of the first one that did not fit, so each retry resumes there.
+    """
+    from rtree import core  # imported on first use, like rtree.index
+
+    mins = np.ascontiguousarray(lo, dtype=np.float64)
+    maxs = np.ascontiguousarray(hi, dtype=np.float64)
+    n, d = mins.shape
+    if kind == "intersects":
+        call = core.rt.Index_Intersects_id_v
+        head: tuple[int, ...] = ()
+        tail: tuple[None, ...] = ()
+    elif kind == "nearest":
+        call = core.rt.Index_NearestNeighbors_id_v
+        head, tail = (k,), (None,)  # non-strict k (every tie comes back), no distance output
+    else:
+        raise ValueError(f"unknown bulk query kind {kind!r}")
+    ids = np.empty(max(2 * n, n * k, 64), dtype=np.int64)
+    counts = np.zeros(n, dtype=np.uint64)
+    done = ctypes.c_int64(0)
+    first, filled = 0, 0  # first unfinished query, ids written so far
+    while True:
+        call(
+            index.handle,
+            *head,
+            n - first,
+            d,
+            ids.shape[0] - filled,
+            d,  # row stride, in doubles (C-contiguous (n, d))
+            1,  # column stride
+            mins[first:].ctypes.data,
+            maxs[first:].ctypes.data,
+            ids[filled:].ctypes.data,
+            counts[first:].ctypes.data,
+            *tail,
+            ctypes.byref(done),
+        )
+        finished = int(done.value)
+        filled += int(counts[first : first + finished].sum())
+        first += finished
+        if first == n:
+            return ids[:filled], counts.astype(np.int64)
+        needed = filled + int(counts[first])  # the query that did not fit, at least
+        grown = np.empty(max(2 * ids.shape[0], needed), dtype=np.int64)
+        grown[:filled] = ids[:filled]
+        ids = grown
 
 
 def _vector(values: ArrayLike, entity: str, field: str) -> FloatArray:

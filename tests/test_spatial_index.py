@@ -219,6 +219,36 @@ def test_nearest_ties_are_deterministic(
     np.testing.assert_array_equal(index.nearest(pts, k=k), _brute_nearest(ids, mins, maxs, pts, k))
 
 
+def test_queries_whose_hits_outgrow_the_first_result_buffer() -> None:
+    # rtree's batch calls start with room for 2 hits per query and grow the buffer when more
+    # come back; rtree 1.4.1's own growth step fails under numpy < 2 (a float size). 2,000
+    # overlapping boxes at UTM scale: every query below hits hundreds to thousands of them.
+    rng = np.random.default_rng(20)
+    ids, mins, maxs = _random_boxes(rng, 2000, span=20.0, size=60.0)
+    index = SpatialIndex(ids, mins, maxs)
+    centre = UTM + 30.0
+    single = index.intersection(centre - 1.0, centre + 1.0)
+    np.testing.assert_array_equal(
+        single, _brute_intersection(ids, mins, maxs, centre - 1.0, centre + 1.0)
+    )
+    assert single.size > 200
+    qmins = UTM + rng.uniform(10.0, 40.0, (40, 3))
+    qmaxs = qmins + rng.uniform(0.0, 5.0, (40, 3))
+    query_index, hit_ids = index.intersection_batch(qmins, qmaxs)
+    counts = np.bincount(query_index, minlength=40)
+    assert counts.min() > 2
+    assert hit_ids.size > 100 * 40  # far past the first buffer
+    for i in range(40):
+        np.testing.assert_array_equal(
+            hit_ids[query_index == i], _brute_intersection(ids, mins, maxs, qmins[i], qmaxs[i])
+        )
+    # nearest keeps every tie: a point inside many boxes has them all at distance 0
+    points = np.array([centre, centre + 2.0, UTM + 1000.0])
+    np.testing.assert_array_equal(
+        index.nearest(points, k=3), _brute_nearest(ids, mins, maxs, points, 3)
+    )
+
+
 def test_plane_side_and_straddling(
     boxes: tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]],
 ) -> None:
