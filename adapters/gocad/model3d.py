@@ -224,6 +224,7 @@ def attach_model3d(
         options.merge_tolerance_for(diagonal),
         bstones,
     )
+    warn_idle_bstones(surfaces, corners, options.merge_tolerance_for(diagonal), builder.warn)
     topology = Topology(
         corners=tuple(corners),
         arcs=tuple(arcs),
@@ -318,7 +319,33 @@ def _bstone_points(surfaces: list[Surface]) -> NDArray[np.float64]:
     return np.concatenate(points) if points else np.zeros((0, 3))
 
 
-def border_topology(surfaces: list[Surface], options: Any) -> Topology:
+def warn_idle_bstones(
+    surfaces: list[Surface], corners: list[Any], tolerance: float, warn: Any
+) -> None:
+    """One warning per surface whose BSTONEs mark no corner (not on a border of the model):
+    a writer then puts its BSTONEs at the corners, so they need not come back as they were."""
+    if not corners:
+        points = np.zeros((0, 3))
+    else:
+        points = np.array([c.point for c in corners], dtype=np.float64).reshape(-1, 3)
+    for surface in surfaces:
+        stones = gocad_section(surface.metadata).get("bstones") or []
+        if not stones:
+            continue
+        at = surface.vertices[np.asarray(stones, dtype=np.int64)]
+        if points.shape[0]:
+            gaps = np.abs(at[:, None, :] - points[None, :, :]).max(axis=2).min(axis=1)
+            idle = [int(v) for v, gap in zip(stones, gaps, strict=True) if gap > tolerance]
+        else:
+            idle = [int(v) for v in stones]
+        if idle:
+            warn(
+                f"surface {surface.name!r}: {len(idle)} BSTONE(s) not on a border of the model "
+                f"(vertex index {idle[0]}{', ...' if len(idle) > 1 else ''}) mark no corner"
+            )
+
+
+def border_topology(surfaces: list[Surface], options: Any, warn: Any | None = None) -> Topology:
     """Patches (one per TFACE) with corners from BSTONEs and arcs, for TSurfs outside a Model3d."""
     patches = [
         Patch(id=len_ + 0, surface=int(s.id or 0), label=label, name=f"{s.name}:{label}")
@@ -335,6 +362,8 @@ def border_topology(surfaces: list[Surface], options: Any) -> Topology:
         options.merge_tolerance_for(diagonal),
         _bstone_points(surfaces),
     )
+    if warn is not None:
+        warn_idle_bstones(surfaces, corners, options.merge_tolerance_for(diagonal), warn)
     return Topology(
         corners=tuple(corners),
         arcs=tuple(arcs),

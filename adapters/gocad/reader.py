@@ -168,7 +168,7 @@ class _Builder:
         elif any(gocad_section(e.metadata).get("borders") for e in surfaces):
             from geobrep.adapters.gocad.model3d import border_topology
 
-            topology = border_topology(surfaces, self.options)
+            topology = border_topology(surfaces, self.options, self.warn)
         try:
             scene = Scene(
                 entities=[*self.entities, *blocks],

@@ -98,3 +98,19 @@ def test_mutated_files_read_or_fail_cleanly(name: str, mutations: list[tuple[obj
                     assert arrays_identical(a.vertices, b.vertices)  # type: ignore[attr-defined]
         else:
             assert again == scene
+
+
+def test_a_bstone_left_off_the_border_is_reported() -> None:
+    """ts-2props.ts without one of its TRGL lines: its BSTONE no longer lies on a border, so it
+    marks no corner; the reader says so (the writer then puts BSTONEs at the corners)."""
+    data = mutate(TEXTS["ts-2props.ts"], [("drop", 525)])
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "ts-2props.ts"
+        path.write_bytes(data)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", GocadWarning)
+            scene = geobrep.read(path, format="gocad")
+        messages = [str(w.message) for w in caught]
+        assert any("BSTONE(s) not on a border" in m for m in messages)
+        again = geobrep.read(geobrep.write(scene, Path(folder) / "again.ts"))
+        assert again.topology == scene.topology
