@@ -10,17 +10,18 @@ STAMPS := $(VENV)/.geobrep-stamps
 EXAMPLE_PLUGIN := docs/examples/geobrep-example-plugin
 PIP_QUIET := --quiet --disable-pip-version-check
 
-.PHONY: demo test lint typecheck pytest bench schemas sysdeps clean help
+.PHONY: demo test test-newest test-min lint typecheck pytest bench schemas sysdeps clean help
 
 help:
 	@echo "make demo   - run the demo on the built-in sample model (writes demo-output/)"
-	@echo "make test   - ruff + mypy + the whole test suite"
+	@echo "make test   - ruff + mypy + the whole test suite (newest allowed dependencies)"
+	@echo "make test-min - the suite on the lowest versions pyproject.toml allows (.venv-min)"
 	@echo "make bench  - benchmarks (not part of make test)"
 
 $(PY):
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "geobrep needs Python 3.11 or newer: set PYTHON=python3.11 (or newer)")'
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install $(PIP_QUIET) --upgrade "pip>=23.1" "setuptools>=69" wheel
+	$(PY) -m pip install $(PIP_QUIET) --upgrade "pip>=23.1" "setuptools>=77.0.1" wheel
 
 $(STAMPS)/base: pyproject.toml | $(PY)
 	$(PY) -m pip install $(PIP_QUIET) -e .
@@ -72,6 +73,38 @@ pytest: $(STAMPS)/test sysdeps
 	$(PY) -m pytest
 
 test: lint typecheck pytest
+
+# `make test` installs the newest versions pyproject.toml allows; test-newest names that.
+test-newest: test
+
+# The suite on the floors: Python 3.11 and every core, build-system and extra requirement pinned
+# to its declared lower bound (tools/floors.py), in a venv of its own. geobrep itself is built
+# with the floor setuptools (no build isolation), so the build-system floor is tested too.
+MIN_PYTHON ?= python3.11
+MIN_VENV   ?= .venv-min
+MIN_PY     := $(MIN_VENV)/bin/python
+MIN_EXTRAS := test open3d gis viz dask
+MIN_STAMP  := $(MIN_VENV)/.geobrep-floors
+
+$(MIN_STAMP): pyproject.toml tools/floors.py
+	@$(MIN_PYTHON) -c 'import sys; sys.exit(0 if sys.version_info[:2] == (3, 11) else "make test-min runs on the floor Python, 3.11: set MIN_PYTHON=python3.11")'
+	rm -rf $(MIN_VENV)
+	$(MIN_PYTHON) -m venv $(MIN_VENV)
+	$(MIN_PY) -m pip install $(PIP_QUIET) --upgrade "pip>=23.1"
+	$(MIN_PY) tools/floors.py --build > $(MIN_VENV)/build-floors.txt
+	$(MIN_PY) tools/floors.py $(MIN_EXTRAS) > $(MIN_VENV)/floors.txt
+	$(MIN_PY) tools/floors.py --requirements $(MIN_EXTRAS) > $(MIN_VENV)/requirements.txt
+	$(MIN_PY) -m pip install $(PIP_QUIET) -r $(MIN_VENV)/build-floors.txt
+	$(MIN_PY) -m pip install $(PIP_QUIET) -c $(MIN_VENV)/floors.txt -c $(MIN_VENV)/build-floors.txt \
+	  -r $(MIN_VENV)/requirements.txt
+	$(MIN_PY) -m pip install $(PIP_QUIET) --no-deps --no-build-isolation -e .
+	$(MIN_PY) -m pip check
+	$(MIN_PY) -m pip freeze --exclude-editable > $(MIN_VENV)/installed.txt
+	@touch $@
+
+test-min: $(MIN_STAMP) sysdeps
+	@$(MIN_PY) -c 'import numpy, rtree, scipy; print(f"floors: numpy {numpy.__version__}, rtree {rtree.__version__}, scipy {scipy.__version__} (all pins: $(MIN_VENV)/installed.txt)")'
+	$(MIN_PY) -m pytest -p no:cacheprovider
 
 schemas: $(STAMPS)/base
 	$(PY) -m geobrep.schemas
