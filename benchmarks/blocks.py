@@ -34,8 +34,8 @@ from typing import Any
 import numpy as np
 
 import geobrep
-from geobrep.building import build_blocks
 from geobrep.geometry import mesh
+from geobrep.ops.building import build_blocks
 
 
 def best_of(function: Callable[[], Any], repeat: int) -> tuple[float, float, Any]:

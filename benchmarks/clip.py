@@ -30,7 +30,7 @@ def main() -> None:
     import vtk
 
     import geobrep
-    from geobrep.clipping import clip
+    from geobrep.ops.clipping import clip
 
     sphere = trimesh.creation.icosphere(subdivisions=args.subdivisions)
     vertices = np.asarray(sphere.vertices, dtype=np.float64)

@@ -29,9 +29,9 @@ from typing import Any
 
 import numpy as np
 
-from geobrep.entities import Surface
-from geobrep.io import read, write
-from geobrep.scene import Scene
+from geobrep.model.entities import Surface
+from geobrep.model.scene import Scene
+from geobrep.ops.io import read, write
 
 
 def make_surface(triangles: int) -> Surface:

@@ -70,7 +70,7 @@ def run_body(name: str, vertices: np.ndarray, faces: np.ndarray, analytic: float
     import trimesh
 
     import geobrep
-    from geobrep.voxelization import VoxelizationWarning, voxelize
+    from geobrep.ops.voxelization import VoxelizationWarning, voxelize
 
     offset = np.array([450_000.0, 6_700_000.0, -500.0])  # UTM-scale coordinates
     surface = geobrep.Surface(vertices=vertices + offset, faces=faces, name=name)

@@ -15,24 +15,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from geobrep.building import build_blocks
-from geobrep.clipping import clip, clip_box, section
-from geobrep.conversion import ConversionSummary, FileReport, convert
-from geobrep.crs import CRS
-from geobrep.crs_ops import from_geodataframe, to_geodataframe
-from geobrep.entities import (
-    Annotation,
-    Block,
-    Entity,
-    LinearOctree,
-    NurbsSurface,
-    PatchSide,
-    PointSet,
-    Polygon,
-    PolyLine,
-    Surface,
-    TetMesh,
-)
+from geobrep.batch.conversion import ConversionSummary, FileReport, convert
 from geobrep.errors import (
     DegenerateGeometryError,
     EntityNotFoundError,
@@ -46,19 +29,36 @@ from geobrep.errors import (
     TopologyError,
     UnknownFormatError,
 )
-from geobrep.fitting import FitReport, FitResult, fit
 from geobrep.geometry import BoundingBox, Plane
-from geobrep.io import read, write
-from geobrep.map_products import map_products
-from geobrep.properties import Property
-from geobrep.scene import Group, Scene
-from geobrep.topology import Arc, Corner, Patch, Topology
-from geobrep.voxelization import VoxelizationWarning, voxelize
+from geobrep.gis.crs_ops import from_geodataframe, to_geodataframe
+from geobrep.gis.map_products import map_products
+from geobrep.model.crs import CRS
+from geobrep.model.entities import (
+    Annotation,
+    Block,
+    Entity,
+    LinearOctree,
+    NurbsSurface,
+    PatchSide,
+    PointSet,
+    Polygon,
+    PolyLine,
+    Surface,
+    TetMesh,
+)
+from geobrep.model.properties import Property
+from geobrep.model.scene import Group, Scene
+from geobrep.model.topology import Arc, Corner, Patch, Topology
+from geobrep.ops.building import build_blocks
+from geobrep.ops.clipping import clip, clip_box, section
+from geobrep.ops.fitting import FitReport, FitResult, fit
+from geobrep.ops.io import read, write
+from geobrep.ops.voxelization import VoxelizationWarning, voxelize
 
 if TYPE_CHECKING:
     from geobrep import datasets, plugins
-    from geobrep.pipeline import Pipeline
-    from geobrep.pipeline_run import PipelineSummary, run_pipeline
+    from geobrep.batch.pipeline import Pipeline
+    from geobrep.batch.pipeline_run import PipelineSummary, run_pipeline
 
 __version__ = "0.1.0"
 
@@ -123,9 +123,9 @@ __all__ = [
 _LAZY_SUBMODULES = {"plugins", "datasets"}
 #: Public names whose modules are imported on first use (their pydantic models take a while).
 _LAZY_NAMES = {
-    "Pipeline": "geobrep.pipeline",
-    "PipelineSummary": "geobrep.pipeline_run",
-    "run_pipeline": "geobrep.pipeline_run",
+    "Pipeline": "geobrep.batch.pipeline",
+    "PipelineSummary": "geobrep.batch.pipeline_run",
+    "run_pipeline": "geobrep.batch.pipeline_run",
 }
 
 

@@ -14,10 +14,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from geobrep import building, clipping, conversion, crs_ops, datasets, fitting, voxelization
+from geobrep import datasets
+from geobrep.batch import conversion
 from geobrep.errors import MissingDependencyError, UnknownFormatError
-from geobrep.io import atomic_write, read, write
-from geobrep.scene import Scene
+from geobrep.gis import crs_ops
+from geobrep.model.scene import Scene
+from geobrep.ops import building, clipping, fitting, voxelization
+from geobrep.ops.io import atomic_write, read, write
 
 __all__ = ["STAGES", "DemoContext", "run_demo"]
 

@@ -22,7 +22,12 @@ from typing import TYPE_CHECKING
 import pluggy
 
 if TYPE_CHECKING:
-    from geobrep.registry import BuilderRegistry, ClipperRegistry, FitterRegistry, FormatRegistry
+    from geobrep.host.registry import (
+        BuilderRegistry,
+        ClipperRegistry,
+        FitterRegistry,
+        FormatRegistry,
+    )
 
 __all__ = ["PROJECT_NAME", "GeobrepSpecs", "hookimpl", "hookspec"]
 
@@ -40,7 +45,7 @@ class GeobrepSpecs:
 
     @hookspec
     def geobrep_register_formats(self, registry: FormatRegistry) -> None:
-        """Register file formats: one :class:`~geobrep.registry.FormatSpec` per format.
+        """Register file formats: one :class:`~geobrep.host.registry.FormatSpec` per format.
 
         Example::
 
@@ -55,7 +60,7 @@ class GeobrepSpecs:
 
     @hookspec
     def geobrep_register_clippers(self, registry: ClipperRegistry) -> None:
-        """Register plane clippers: one :class:`~geobrep.registry.ClipperSpec` per entity type.
+        """Register plane clippers: one :class:`~geobrep.plugins.ClipperSpec` per entity type.
 
         Example::
 
@@ -68,7 +73,7 @@ class GeobrepSpecs:
 
     @hookspec
     def geobrep_register_fitters(self, registry: FitterRegistry) -> None:
-        """Register surface or curve fitters: :class:`~geobrep.registry.FitterSpec` items.
+        """Register surface or curve fitters: :class:`~geobrep.host.registry.FitterSpec` items.
 
         Example::
 
@@ -81,7 +86,7 @@ class GeobrepSpecs:
 
     @hookspec
     def geobrep_register_builders(self, registry: BuilderRegistry) -> None:
-        """Register topology or block builders: :class:`~geobrep.registry.BuilderSpec` items.
+        """Register topology or block builders: :class:`~geobrep.host.registry.BuilderSpec` items.
 
         Example::
 

@@ -30,8 +30,8 @@ from typing import TYPE_CHECKING, Any
 from geobrep.hookspecs import hookimpl
 
 if TYPE_CHECKING:
-    from geobrep.plugin_loader import PluginInfo
-    from geobrep.registry import (
+    from geobrep.host.loader import PluginInfo
+    from geobrep.host.registry import (
         BuilderSpec,
         ClipperSpec,
         FitterSpec,
@@ -56,13 +56,13 @@ __all__ = [
 ]
 
 _LAZY = {
-    "BuilderSpec": "geobrep.registry",
-    "ClipperSpec": "geobrep.registry",
-    "FitterSpec": "geobrep.registry",
-    "FormatCapabilities": "geobrep.registry",
-    "FormatSpec": "geobrep.registry",
-    "Registries": "geobrep.registry",
-    "PluginInfo": "geobrep.plugin_loader",
+    "BuilderSpec": "geobrep.host.registry",
+    "ClipperSpec": "geobrep.host.registry",
+    "FitterSpec": "geobrep.host.registry",
+    "FormatCapabilities": "geobrep.host.registry",
+    "FormatSpec": "geobrep.host.registry",
+    "Registries": "geobrep.host.registry",
+    "PluginInfo": "geobrep.host.loader",
 }
 
 
@@ -86,7 +86,7 @@ def list_plugins() -> list[PluginInfo]:
         >>> [(p.name, p.status) for p in list_plugins()]  # doctest: +SKIP
         [('native', 'loaded'), ('example', 'loaded')]
     """
-    from geobrep.plugin_loader import get_host
+    from geobrep.host.loader import get_host
 
     return get_host().plugins
 
@@ -98,7 +98,7 @@ def registries() -> Registries:
         >>> registries().formats.choose_reader("points.xyz").name  # doctest: +SKIP
         'xyz'
     """
-    from geobrep.plugin_loader import get_host
+    from geobrep.host.loader import get_host
 
     return get_host().registries
 
@@ -117,7 +117,7 @@ def register(plugin: object, name: str) -> PluginInfo:
         >>> register(MyPlugin(), "my-plugin").registered["fitters"]  # doctest: +SKIP
         ('mine',)
     """
-    from geobrep.plugin_loader import register_plugin
+    from geobrep.host.loader import register_plugin
 
     return register_plugin(plugin, name)
 
@@ -128,7 +128,7 @@ def reload() -> None:
     Example:
         >>> reload()  # doctest: +SKIP
     """
-    from geobrep.plugin_loader import get_host, reset
+    from geobrep.host.loader import get_host, reset
 
     reset()
     get_host()

@@ -25,7 +25,7 @@ SCHEMA_NAMES = ("scene", "pipeline")
 def generate() -> dict[str, dict[str, Any]]:
     """Build every schema from the current models."""
     from geobrep.adapters.native.container import NativeDocument
-    from geobrep.pipeline import Pipeline
+    from geobrep.batch.pipeline import Pipeline
 
     schemas = {
         "scene": NativeDocument.model_json_schema(mode="serialization"),

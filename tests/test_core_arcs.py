@@ -1,4 +1,4 @@
-"""geobrep.arcs.build_corners_and_arcs: corners and arcs rebuilt from patches."""
+"""geobrep.model.arcs.build_corners_and_arcs: corners and arcs rebuilt from patches."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from geobrep import Scene, Surface
-from geobrep.arcs import build_corners_and_arcs
-from geobrep.topology import Topology
+from geobrep.model.arcs import build_corners_and_arcs
+from geobrep.model.topology import Topology
 
 
 def _cyclic_equal(a: tuple[int, ...], b: tuple[int, ...]) -> bool:

@@ -15,7 +15,7 @@ import geobrep
 OWNED_ELSEWHERE = (
     "geobrep.plugins",
     "geobrep.adapters",
-    "geobrep.fitting",
+    "geobrep.ops.fitting",
 )
 
 
@@ -48,4 +48,6 @@ def test_module_examples(name: str, tmp_path: Path, monkeypatch: pytest.MonkeyPa
 
 
 def test_discovery_finds_the_core_modules() -> None:
-    assert {"geobrep.scene", "geobrep.io", "geobrep.model_orientation"} <= set(DOCTEST_MODULES)
+    assert {"geobrep.model.scene", "geobrep.ops.io", "geobrep.model.orientation"} <= set(
+        DOCTEST_MODULES
+    )

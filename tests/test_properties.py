@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from geobrep import EntityValidationError, PointSet, Property, Surface
-from geobrep.properties import PropertyMap
+from geobrep.model.properties import PropertyMap
 
 TRIANGLE = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
 

@@ -1,4 +1,4 @@
-"""Tests for geobrep.spatial_index: brute-force references, threads, pickling, empty index."""
+"""geobrep.geometry.spatial_index: brute-force references, threads, pickling, empty index."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 
 from geobrep.errors import EntityValidationError
 from geobrep.geometry import BoundingBox, Plane
-from geobrep.spatial_index import SpatialIndex
+from geobrep.geometry.spatial_index import SpatialIndex
 
 UTM = np.array([450_000.0, 6_700_000.0, 0.0])
 

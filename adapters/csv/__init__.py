@@ -29,10 +29,10 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters.csv.table import read_points_table, write_points_table
-from geobrep.capabilities import restrict_scene
 from geobrep.hookspecs import hookimpl
-from geobrep.registry import FormatCapabilities, FormatRegistry, FormatSpec
-from geobrep.scene import Scene
+from geobrep.host.capabilities import restrict_scene
+from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.model.scene import Scene
 
 __all__ = ["CAPABILITIES", "CsvOptions", "geobrep_register_formats"]
 

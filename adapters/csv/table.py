@@ -11,11 +11,11 @@ import numpy as np
 import orjson
 from numpy.typing import NDArray
 
-from geobrep.crs import CRS
-from geobrep.entities import PointSet
 from geobrep.errors import FileAccessError, FormatError, GeobrepError
-from geobrep.properties import Property
-from geobrep.scene import Scene
+from geobrep.model.crs import CRS
+from geobrep.model.entities import PointSet
+from geobrep.model.properties import Property
+from geobrep.model.scene import Scene
 
 __all__ = ["looks_like_points_table", "read_points_table", "write_points_table"]
 

@@ -9,8 +9,8 @@ pyogrio and shapely (the ``gis`` extra) are imported only when a file is read or
 from __future__ import annotations
 
 from geobrep.adapters.gis.formats import gis_formats
+from geobrep.host.registry import FormatRegistry
 from geobrep.plugins import hookimpl
-from geobrep.registry import FormatRegistry
 
 __all__ = ["geobrep_register_formats"]
 

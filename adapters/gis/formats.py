@@ -6,7 +6,7 @@ it with a ``layer`` column that the reader splits again; a shapefile holds one l
 with ``layer=`` when a scene makes several).
 
 Sections in their plane's coordinates (``metadata["section_frame"]``, see
-:func:`geobrep.map_products.to_section_plane`) go to GeoPackage layers without a CRS, the frame
+:func:`geobrep.gis.map_products.to_section_plane`) go to GeoPackage layers without a CRS, the frame
 in the layer metadata (``geobrep_section_frame``, JSON); GeoJSON and shapefiles cannot say what
 such coordinates are, so those entities are left out there with a warning.
 """
@@ -26,9 +26,8 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import ConfigDict
 
-from geobrep.crs import CRS
 from geobrep.errors import FormatError, MissingDependencyError
-from geobrep.feature_tables import (
+from geobrep.gis.feature_tables import (
     RESERVED_COLUMNS,
     FeatureTable,
     FeatureWarning,
@@ -36,9 +35,10 @@ from geobrep.feature_tables import (
     entities_to_tables,
     tables_to_entities,
 )
-from geobrep.map_products import SECTION_FRAME_KEY
-from geobrep.registry import FormatCapabilities, FormatSpec
-from geobrep.scene import Scene
+from geobrep.gis.map_products import SECTION_FRAME_KEY
+from geobrep.host.registry import FormatCapabilities, FormatSpec
+from geobrep.model.crs import CRS
+from geobrep.model.scene import Scene
 
 __all__ = ["GisOptions", "gis_formats", "looks_like_geojson", "read_gis", "write_gis"]
 
@@ -75,7 +75,7 @@ def _pyogrio() -> Any:
 
 
 def _final_name(path: Path) -> Path:
-    """The name the user asked for, from the temporary name :func:`geobrep.io.atomic_write` uses."""
+    """The name the user asked for, from a temporary name of :func:`geobrep.ops.io.atomic_write`."""
     return path.with_name(re.sub(r"^\.(.*)\.tmp-[0-9a-f]+(\.[^.]*)?$", r"\1\2", path.name))
 
 
@@ -97,7 +97,7 @@ def looks_like_geojson(head: bytes) -> bool:
 def _crs_for_layer(text: str | None, stored: CRS | None) -> CRS | None:
     if not text:
         return None
-    from geobrep.crs_ops import CRSError, crs_from_user_input
+    from geobrep.gis.crs_ops import CRSError, crs_from_user_input
 
     try:
         parsed = crs_from_user_input(text)
@@ -116,7 +116,7 @@ def _crs_text(crs: CRS | None) -> str | None:
         return None
     if crs.epsg is not None and not crs.vertical_datum:
         return f"EPSG:{crs.epsg}"
-    from geobrep.crs_ops import CRSError, parse_crs
+    from geobrep.gis.crs_ops import CRSError, parse_crs
 
     try:
         return str(parse_crs(crs).to_wkt())
@@ -136,7 +136,7 @@ def _geojson_crs(path: Path, crs: CRS | None) -> CRS | None:
     if found is None:
         return crs  # RFC 7946: WGS 84 longitude/latitude, as GDAL says
     declared = found.group(1).decode("utf-8", "replace")
-    from geobrep.crs_ops import CRSError, crs_from_user_input
+    from geobrep.gis.crs_ops import CRSError, crs_from_user_input
 
     try:
         return crs_from_user_input(declared)
@@ -278,7 +278,7 @@ def read_gis(path: Path, options: GisOptions, driver: str) -> Scene:
 
 def _layer_frame(path: Path, layer: str) -> Any:
     """The section frame a GeoPackage layer's metadata holds, or None."""
-    from geobrep.map_products import SectionFrame
+    from geobrep.gis.map_products import SectionFrame
 
     info = _pyogrio().read_info(path, layer=layer)
     text = (info.get("layer_metadata") or {}).get(FRAME_METADATA_KEY)
@@ -316,7 +316,7 @@ def _fields(
 
 
 def _merged_for_single_layer(tables: list[FeatureTable]) -> FeatureTable:
-    from geobrep.feature_tables import merge_columns
+    from geobrep.gis.feature_tables import merge_columns
 
     pieces = [
         (len(t), {LAYER_COLUMN: np.full(len(t), t.layer, dtype=object), **t.columns})

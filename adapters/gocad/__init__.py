@@ -11,8 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from geobrep.hookspecs import hookimpl
-from geobrep.registry import FormatCapabilities, FormatRegistry, FormatSpec
-from geobrep.scene import Scene
+from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.model.scene import Scene
 
 __all__ = ["EXTENSIONS", "geobrep_register_formats", "looks_like_gocad"]
 

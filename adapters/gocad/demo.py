@@ -9,9 +9,9 @@ from typing import Any
 import numpy as np
 
 from geobrep.demo import DemoContext
-from geobrep.entities import Block
-from geobrep.io import read, write
-from geobrep.scene import Scene
+from geobrep.model.entities import Block
+from geobrep.model.scene import Scene
+from geobrep.ops.io import read, write
 
 __all__ = ["demo_stage"]
 

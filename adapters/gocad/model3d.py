@@ -6,8 +6,8 @@
 * ``REGION`` lists signed TFACE ids: ``+k`` means the region lies on the side the normal of
   TFACE k's key triangle points to, in z-up coordinates (after ``ZPOSITIVE Depth`` is negated).
   ``+k ... -k`` in one region is a surface inside it; the ``Universe`` region is the outside.
-* Corners and arcs are rebuilt from the patches (:mod:`geobrep.arcs`), with the BSTONE vertices
-  as extra corners; coincident vertices of different TSurfs are joined with a tolerance.
+* Corners and arcs are rebuilt from the patches (:mod:`geobrep.model.arcs`), with the BSTONE
+  vertices as extra corners; coincident vertices of different TSurfs are joined with a tolerance.
 """
 
 from __future__ import annotations
@@ -19,12 +19,12 @@ from numpy.typing import NDArray
 
 from geobrep.adapters.gocad.objects import gocad_section
 from geobrep.adapters.gocad.parser import GocadObject
-from geobrep.arcs import corners_and_arcs
-from geobrep.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
 from geobrep.geometry.bbox import column_extremes
-from geobrep.model_orientation import orient_patches
-from geobrep.scene import Group
-from geobrep.topology import Patch, Topology
+from geobrep.model.arcs import corners_and_arcs
+from geobrep.model.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
+from geobrep.model.orientation import orient_patches
+from geobrep.model.scene import Group
+from geobrep.model.topology import Patch, Topology
 
 __all__ = ["attach_model3d", "border_topology", "find_key_triangle"]
 

@@ -19,9 +19,9 @@ from numpy.typing import NDArray
 from geobrep.adapters.gocad.headers import color_from_text, quote, quote_rest
 from geobrep.adapters.gocad.numbers import format_float, row_pieces
 from geobrep.adapters.gocad.parser import GocadWarning
-from geobrep.crs import CRS
-from geobrep.entities import Entity
-from geobrep.properties import Property
+from geobrep.model.crs import CRS
+from geobrep.model.entities import Entity
+from geobrep.model.properties import Property
 
 __all__ = ["ObjectText", "VertexWriter", "crs_block", "part_vertex_ranges"]
 

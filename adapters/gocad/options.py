@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from geobrep.arcs import DEFAULT_RELATIVE_TOLERANCE
+from geobrep.model.arcs import DEFAULT_RELATIVE_TOLERANCE
 
 __all__ = ["GocadOptions"]
 

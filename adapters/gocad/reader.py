@@ -1,4 +1,4 @@
-"""Turn parsed GOCAD objects into a geobrep :class:`~geobrep.scene.Scene`.
+"""Turn parsed GOCAD objects into a geobrep :class:`~geobrep.Scene`.
 
 * TSurf → :class:`Surface` with one patch per TFACE; PLine → :class:`PolyLine` with one part per
   ILINE (split where its SEGs do not chain); VSet → :class:`PointSet`; TSolid / LightTSolid →
@@ -6,7 +6,7 @@
   faces ``# CTETRA`` and the MODEL triangles put on surfaces, named by MODEL_REGION seeds (plus
   one :class:`Surface` per SURFACE of its MODEL section); Model3d → its member TSurfs,
   ``scene.topology`` (one patch per TFACE) and a :class:`Block` per REGION; groups →
-  :class:`~geobrep.scene.Group` s.
+  :class:`~geobrep.model.scene.Group` s.
 * ``ZPOSITIVE Depth`` negates z (triangle winding is kept); the scene's CRS records it.
 * Everything else the file says is kept in ``metadata["gocad"]`` so that a writer can restore it.
 """
@@ -28,13 +28,13 @@ from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.adapters.gocad.parser import GROUP_TYPES, GocadObject, GocadWarning, parse_source
 from geobrep.adapters.gocad.regions import TetFaces, root_vertices
 from geobrep.adapters.gocad.tables import ResolvedVertices
-from geobrep.capabilities import SKIPPED_ON_READ
-from geobrep.crs import CRS
-from geobrep.entities import Entity, PointSet, PolyLine, Surface, TetMesh
 from geobrep.errors import EntityValidationError, FormatError, TopologyError
-from geobrep.model_orientation import orient_blocks
-from geobrep.properties import Property
-from geobrep.scene import Group, Scene
+from geobrep.host.capabilities import SKIPPED_ON_READ
+from geobrep.model.crs import CRS
+from geobrep.model.entities import Entity, PointSet, PolyLine, Surface, TetMesh
+from geobrep.model.orientation import orient_blocks
+from geobrep.model.properties import Property
+from geobrep.model.scene import Group, Scene
 
 __all__ = ["FLAG_PROPERTY", "GocadReadOptions", "crs_from_block", "read_gocad"]
 

@@ -35,11 +35,11 @@ from geobrep.adapters.gocad.objects import (
     z_sign_of,
 )
 from geobrep.adapters.gocad.options import GocadOptions
-from geobrep.arcs import DEFAULT_RELATIVE_TOLERANCE
-from geobrep.entities import Block, Entity, PointSet, PolyLine, Surface, TetMesh
 from geobrep.errors import FormatError
 from geobrep.geometry.bbox import column_extremes
-from geobrep.scene import Group, Scene
+from geobrep.model.arcs import DEFAULT_RELATIVE_TOLERANCE
+from geobrep.model.entities import Block, Entity, PointSet, PolyLine, Surface, TetMesh
+from geobrep.model.scene import Group, Scene
 
 __all__ = ["OBJECT_TYPES", "write_gocad"]
 
@@ -611,14 +611,15 @@ class _BorderPlaces:
     def fit(self, bstones: list[int], borders: list[tuple[int, int]]) -> bool:
         """Whether the source's BSTONE/BORDER lines still describe the scene's corners/arcs.
 
-        A BSTONE on an arc must be at a corner (else it would make one), a BORDER must start
-        at a corner along an arc edge. A surface not read from GOCAD without any gets them.
+        A BSTONE on an arc must be at a corner (else it would make one); a BORDER must run
+        along an arc edge (where it starts does not change the corners a reader finds). A
+        surface not read from GOCAD without any gets them.
         """
         if not bstones and not borders:
             return gocad_metadata(self.surface).get("type") == "TSurf"
         if any(self.on_arc[v] and not self.is_corner[v] for v in bstones):
             return False
-        return all(self.is_corner[a] and self.on_arc[b] and self._is_edge(a, b) for a, b in borders)
+        return all(self.on_arc[a] and self.on_arc[b] and self._is_edge(a, b) for a, b in borders)
 
     def derived(self) -> tuple[list[int], list[tuple[int, int]]]:
         """A BSTONE at every corner, a BORDER from one end of every arc, in this surface."""

@@ -2,7 +2,7 @@
 
 VTU and legacy VTK keep a whole scene (points, lines, surfaces, tetrahedral meshes with names,
 ids, patch labels, properties, CRS and groups); the others keep what they can, and
-:func:`geobrep.capabilities.capability_losses` says what they cannot. Legacy VTK POLYDATA files
+:func:`geobrep.host.capabilities.capability_losses` says what they cannot. Legacy VTK POLYDATA files
 (what ParaView writes for surfaces), which meshio cannot read, are read through pyvista when the
 ``viz`` extra is installed.
 
@@ -21,6 +21,13 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict
 
+from geobrep.adapters.cell_layout import (
+    ENTITY_ARRAY,
+    LAYOUT_TYPES,
+    header_applies,
+    layout_to_scene,
+    scene_to_layout,
+)
 from geobrep.adapters.meshio.bridge import (
     layout_from_mesh,
     mesh_from_layout,
@@ -32,18 +39,11 @@ from geobrep.adapters.meshio.header import (
     embed_vtu_header,
     read_legacy_header,
 )
-from geobrep.capabilities import restrict_scene
-from geobrep.cell_layout import (
-    ENTITY_ARRAY,
-    LAYOUT_TYPES,
-    header_applies,
-    layout_to_scene,
-    scene_to_layout,
-)
 from geobrep.errors import FormatError, MissingDependencyError
 from geobrep.hookspecs import hookimpl
-from geobrep.registry import FormatCapabilities, FormatRegistry, FormatSpec, NoOptions
-from geobrep.scene import Scene
+from geobrep.host.capabilities import restrict_scene
+from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec, NoOptions
+from geobrep.model.scene import Scene
 
 __all__ = [
     "CAPABILITIES",

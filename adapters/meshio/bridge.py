@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.cell_layout import (
+from geobrep.adapters.cell_layout import (
     HEADER_ARRAY,
     CellLayout,
     decode_header,
@@ -27,7 +27,7 @@ from geobrep.cell_layout import (
     scene_to_layout,
 )
 from geobrep.errors import FormatError
-from geobrep.scene import Scene
+from geobrep.model.scene import Scene
 
 __all__ = ["layout_from_mesh", "mesh_from_layout", "read_mesh", "write_mesh"]
 

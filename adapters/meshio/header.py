@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from geobrep.cell_layout import HEADER_ARRAY, decode_header, encode_header
+from geobrep.adapters.cell_layout import HEADER_ARRAY, decode_header, encode_header
 from geobrep.errors import FormatError
 
 __all__ = ["embed_legacy_header", "embed_vtu_header", "read_legacy_header"]

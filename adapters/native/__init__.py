@@ -11,8 +11,8 @@ from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters.native.container import NativeDocument, load, looks_native, save
 from geobrep.hookspecs import hookimpl
-from geobrep.registry import FormatCapabilities, FormatRegistry, FormatSpec
-from geobrep.scene import Scene
+from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.model.scene import Scene
 
 __all__ = ["NativeDocument", "NativeOptions", "geobrep_register_formats", "load", "save"]
 

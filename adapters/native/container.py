@@ -18,10 +18,10 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 import geobrep
-from geobrep.arrays import ARRAY_WRITER, array_reader
 from geobrep.errors import FormatError, GeobrepError
-from geobrep.io import atomic_write
-from geobrep.scene import Scene
+from geobrep.model.arrays import ARRAY_WRITER, array_reader
+from geobrep.model.scene import Scene
+from geobrep.ops.io import atomic_write
 
 __all__ = ["FORMAT_ID", "FORMAT_VERSION", "NativeDocument", "load", "looks_native", "save"]
 

@@ -24,11 +24,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.cell_layout import chain_segments
-from geobrep.entities import Entity, LinearOctree, PointSet, PolyLine, Surface
+from geobrep.adapters.cell_layout import chain_segments
 from geobrep.errors import FormatError, MissingDependencyError
 from geobrep.geometry.morton import morton_decode, morton_encode
-from geobrep.properties import PropertyMap
+from geobrep.model.entities import Entity, LinearOctree, PointSet, PolyLine, Surface
+from geobrep.model.properties import PropertyMap
 
 __all__ = ["Open3dLossWarning", "from_open3d", "open3d_losses", "to_open3d"]
 

@@ -18,10 +18,10 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters.ply.codec import read_ply, write_ply
-from geobrep.capabilities import restrict_scene
 from geobrep.hookspecs import hookimpl
-from geobrep.registry import FormatCapabilities, FormatRegistry, FormatSpec
-from geobrep.scene import Scene
+from geobrep.host.capabilities import restrict_scene
+from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.model.scene import Scene
 
 __all__ = ["CAPABILITIES", "PlyOptions", "geobrep_register_formats", "read_ply", "write_ply"]
 

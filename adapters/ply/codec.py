@@ -2,8 +2,8 @@
 
 A scene is written as one ``vertex`` element (``x y z`` as ``double`` plus one PLY property
 per point-property column), one ``face`` element (``vertex_indices`` plus the face
-properties, among them :data:`~geobrep.cell_layout.ENTITY_ARRAY` and
-:data:`~geobrep.cell_layout.PART_ARRAY`) and, for polylines, one ``edge`` element
+properties, among them :data:`~geobrep.adapters.cell_layout.ENTITY_ARRAY` and
+:data:`~geobrep.adapters.cell_layout.PART_ARRAY`) and, for polylines, one ``edge`` element
 (``vertex1 vertex2``). Names, ids, kinds, units, CRS and groups travel in a
 ``comment geobrep-header {json}`` line. Files from other programs read as one surface (or
 point set) keeping all vertices and every vertex and face property under its PLY name.
@@ -18,17 +18,17 @@ from typing import Any, Final
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.cell_layout import (
+from geobrep.adapters.cell_layout import (
     ENTITY_ARRAY,
     CellLayout,
     header_applies,
     layout_to_scene,
     scene_to_layout,
 )
-from geobrep.entities import PointSet, PolyLine, Surface
 from geobrep.errors import FormatError, MissingDependencyError
-from geobrep.properties import PropertyMap
-from geobrep.scene import Scene
+from geobrep.model.entities import PointSet, PolyLine, Surface
+from geobrep.model.properties import PropertyMap
+from geobrep.model.scene import Scene
 
 __all__ = ["HEADER_COMMENT", "read_ply", "write_ply"]
 

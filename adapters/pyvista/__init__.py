@@ -13,6 +13,7 @@ from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict
 
+from geobrep.adapters.cell_layout import layout_to_scene, scene_to_layout
 from geobrep.adapters.pyvista.convert import (
     dataset_to_layout,
     from_pyvista,
@@ -22,12 +23,11 @@ from geobrep.adapters.pyvista.convert import (
     to_pyvista,
 )
 from geobrep.adapters.pyvista.render import RenderOptions, render_scene
-from geobrep.capabilities import restrict_scene
-from geobrep.cell_layout import layout_to_scene, scene_to_layout
 from geobrep.errors import FormatError
 from geobrep.hookspecs import hookimpl
-from geobrep.registry import FormatCapabilities, FormatRegistry, FormatSpec
-from geobrep.scene import Scene
+from geobrep.host.capabilities import restrict_scene
+from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.model.scene import Scene
 
 __all__ = [
     "PNG_CAPABILITIES",

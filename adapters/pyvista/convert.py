@@ -17,7 +17,7 @@ from typing import Any, Final
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.cell_layout import (
+from geobrep.adapters.cell_layout import (
     HEADER_ARRAY,
     LAYOUT_TYPES,
     CellLayout,
@@ -27,9 +27,9 @@ from geobrep.cell_layout import (
     layout_to_scene,
     scene_to_layout,
 )
-from geobrep.entities import Entity, LinearOctree
 from geobrep.errors import FormatError, MissingDependencyError
-from geobrep.scene import Scene
+from geobrep.model.entities import Entity, LinearOctree
+from geobrep.model.scene import Scene
 
 __all__ = [
     "dataset_to_layout",

@@ -20,7 +20,7 @@ from geobrep.adapters.pyvista.convert import (
     to_pyvista,
 )
 from geobrep.errors import OptionsError
-from geobrep.scene import Scene
+from geobrep.model.scene import Scene
 
 __all__ = ["RenderOptions", "render_scene"]
 

@@ -13,10 +13,10 @@ from pathlib import Path
 from typing import Any
 
 from geobrep.cli.common import add_allow_empty, format_name, read_input
-from geobrep.entities import Block, Entity
 from geobrep.errors import OptionsError
-from geobrep.io import write
-from geobrep.scene import Group, Scene
+from geobrep.model.entities import Block, Entity
+from geobrep.model.scene import Group, Scene
+from geobrep.ops.io import write
 
 __all__ = ["add_parser", "describe", "merge_scenes", "run"]
 
@@ -134,8 +134,8 @@ def _options(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from geobrep.building import build_blocks
-    from geobrep.io import atomic_write
+    from geobrep.ops.building import build_blocks
+    from geobrep.ops.io import atomic_write
 
     sources = [str(path) for path in args.inputs]
     scenes = [read_input(args, path, format=args.input_format) for path in sources]

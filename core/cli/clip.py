@@ -152,8 +152,8 @@ def _describe(scene: Any) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from geobrep.clipping import clip, clip_box
-    from geobrep.io import as_scene, write
+    from geobrep.ops.clipping import clip, clip_box
+    from geobrep.ops.io import as_scene, write
 
     scene = read_input(args, args.input, format=args.format)
     output = Path(args.output)

@@ -25,8 +25,8 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any, Literal, NoReturn, TextIO
 
-from geobrep.entities import Entity
-from geobrep.scene import Scene
+from geobrep.model.entities import Entity
+from geobrep.model.scene import Scene
 
 __all__ = [
     "EXIT_EMPTY",
@@ -358,7 +358,7 @@ def refuse_empty(
 
 def read_input(args: argparse.Namespace, path: str | Path, format: str | None = None) -> Scene:
     """Read a command's input; a file with nothing in it is refused (:func:`refuse_empty`)."""
-    from geobrep.io import read
+    from geobrep.ops.io import read
 
     scene = read(path, format=format)
     if is_empty(scene):

@@ -15,8 +15,8 @@ import sys
 from pathlib import Path
 from typing import Any, Protocol
 
+from geobrep.batch.conversion import ConversionSummary, convert
 from geobrep.cli.common import add_allow_empty, format_name, refuse_empty
-from geobrep.conversion import ConversionSummary, convert
 from geobrep.errors import OptionsError
 
 __all__ = ["add_parser", "run"]

@@ -17,9 +17,9 @@ import json
 from pathlib import Path
 from typing import Any
 
-from geobrep.entities import Entity, PointSet, PolyLine
 from geobrep.errors import FileAccessError, FormatError, OptionsError
-from geobrep.fitting import MAX_TRIANGLES
+from geobrep.model.entities import Entity, PointSet, PolyLine
+from geobrep.ops.fitting import MAX_TRIANGLES
 
 __all__ = ["add_parser", "run"]
 
@@ -66,7 +66,7 @@ def add_parser(subparsers: Any) -> None:
 
 
 def _load_points(path: Path, fmt: str | None, entity: str | None) -> PointSet | PolyLine:
-    from geobrep.io import read
+    from geobrep.ops.io import read
 
     if not path.exists():
         raise FileAccessError("no such file", path)
@@ -99,8 +99,8 @@ def _options(pairs: list[str]) -> dict[str, Any]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from geobrep.fitting import fit
-    from geobrep.io import atomic_write
+    from geobrep.ops.fitting import fit
+    from geobrep.ops.io import atomic_write
 
     points = _load_points(Path(args.points), args.format, args.entity)
     options = _options(args.option)

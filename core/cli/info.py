@@ -8,8 +8,9 @@ import re
 from typing import Any
 
 from geobrep.cli.common import add_allow_empty, format_name, is_empty, refuse_empty
-from geobrep.crs import CRS
-from geobrep.entities import (
+from geobrep.errors import GeobrepError
+from geobrep.model.crs import CRS
+from geobrep.model.entities import (
     Block,
     Entity,
     LinearOctree,
@@ -19,10 +20,9 @@ from geobrep.entities import (
     Surface,
     TetMesh,
 )
-from geobrep.errors import GeobrepError
-from geobrep.io import read
-from geobrep.properties import PropertyMap
-from geobrep.scene import Scene
+from geobrep.model.properties import PropertyMap
+from geobrep.model.scene import Scene
+from geobrep.ops.io import read
 
 __all__ = ["add_parser", "describe_entity", "describe_scene"]
 
@@ -125,7 +125,7 @@ def _parsed_crs(scene: Scene) -> dict[str, Any] | None:
     if scene.crs is None:
         return None
     try:
-        from geobrep.crs_ops import describe_crs
+        from geobrep.gis.crs_ops import describe_crs
     except ImportError:  # pragma: no cover - crs_ops itself is always importable
         return None
     try:

@@ -11,7 +11,7 @@ from typing import Any
 
 from geobrep.cli.common import add_allow_empty, format_name, read_input
 from geobrep.errors import OptionsError
-from geobrep.io import write
+from geobrep.ops.io import write
 
 __all__ = ["add_parser", "run"]
 

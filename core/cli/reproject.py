@@ -37,8 +37,8 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from geobrep.crs_ops import to_crs
-    from geobrep.io import write
+    from geobrep.gis.crs_ops import to_crs
+    from geobrep.ops.io import write
 
     scene = read_input(args, args.input, format=args.format)
     moved = to_crs(scene, args.target, source=args.source)

@@ -55,9 +55,9 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from geobrep.conversion import expand
-    from geobrep.pipeline import Pipeline
-    from geobrep.pipeline_run import run_pipeline
+    from geobrep.batch.conversion import expand
+    from geobrep.batch.pipeline import Pipeline
+    from geobrep.batch.pipeline_run import run_pipeline
 
     pipeline = Pipeline.load(args.pipeline).check()
     inputs = list(args.inputs) or None

@@ -42,8 +42,8 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from geobrep.clipping import section
-    from geobrep.io import write
+    from geobrep.ops.clipping import section
+    from geobrep.ops.io import write
 
     scene = read_input(args, args.input, format=args.format)
     plane = plane_from_args(args)
@@ -75,8 +75,8 @@ def _in_coordinates(panel: Any, plane: Any, coordinates: str) -> tuple[Any, bool
     """The panel in world coordinates, the plane's own, or both (layers ``*_plane``)."""
     import numpy as np
 
-    from geobrep.entities import Polygon
-    from geobrep.map_products import section_frame, to_section_plane
+    from geobrep.gis.map_products import section_frame, to_section_plane
+    from geobrep.model.entities import Polygon
 
     horizontal = float(np.hypot(plane.normal[0], plane.normal[1])) < 1e-12
     if coordinates == "world" or horizontal or not panel.entities:

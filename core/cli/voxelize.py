@@ -82,9 +82,9 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from geobrep.io import write
-    from geobrep.scene import Scene
-    from geobrep.voxelization import voxelize
+    from geobrep.model.scene import Scene
+    from geobrep.ops.io import write
+    from geobrep.ops.voxelization import voxelize
 
     scene = read_input(args, args.input, format=args.format)
     start = time.perf_counter()

@@ -7,9 +7,9 @@ subdivided once and extruded along y, and every section cell becomes the south (
 A volume-preserving fold ``z += A sin(πx/X) sin(πy/Y)`` then bends horizons, fault and top while
 the walls stay planar. Because the construction knows every patch and block, the scene carries
 its patches with their positive/negative blocks and the blocks with their signed patch lists;
-corners and arcs (patches in right-hand order) follow geobrep's one rule (:mod:`geobrep.arcs`),
-the rule of the GOCAD reader and the block builder — a ground truth for the block builder and a
-test bed for clipping and voxelization.
+corners and arcs (patches in right-hand order) follow geobrep's one rule
+(:mod:`geobrep.model.arcs`), the rule of the GOCAD reader and the block builder — a ground
+truth for the block builder and a test bed for clipping and voxelization.
 """
 
 from __future__ import annotations
@@ -22,12 +22,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.arcs import corners_and_arcs
-from geobrep.crs import CRS
-from geobrep.entities import UNIVERSE_KIND, Block, PatchSide, Surface
 from geobrep.geometry import mesh
-from geobrep.scene import Group, Scene
-from geobrep.topology import Patch, Topology
+from geobrep.model.arcs import corners_and_arcs
+from geobrep.model.crs import CRS
+from geobrep.model.entities import UNIVERSE_KIND, Block, PatchSide, Surface
+from geobrep.model.scene import Group, Scene
+from geobrep.model.topology import Patch, Topology
 
 __all__ = ["faulted_layer_cake"]
 
@@ -321,7 +321,8 @@ def _with_topology(
         )
         for (sid, label), pid in patch_ids.items()
     ]
-    # Corners and arcs by geobrep's one rule (geobrep.arcs), as readers and the builder find them.
+    # Corners and arcs by geobrep's one rule (geobrep.model.arcs), as readers and the builder
+    # find them.
     corners, arcs, patch_arcs = corners_and_arcs({int(s.id or 0): s for s in surfaces}, patches)
     patches = [p.model_copy(update={"arcs": tuple(patch_arcs.get(p.id, ()))}) for p in patches]
     blocks = [

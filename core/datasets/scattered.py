@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from geobrep.crs import CRS
-from geobrep.entities import PointSet
-from geobrep.properties import Property
+from geobrep.model.crs import CRS
+from geobrep.model.entities import PointSet
+from geobrep.model.properties import Property
 
 __all__ = ["dome_elevation", "scattered_points"]
 

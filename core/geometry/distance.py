@@ -6,7 +6,7 @@ Ericson's region tests (*Real-Time Collision Detection*, §5.1.5). Fit reports u
 for meshes (a kriged grid, or the tessellation written in place of a NURBS surface).
 
 >>> import numpy as np
->>> from geobrep.entities import Surface
+>>> from geobrep.model.entities import Surface
 >>> tri = Surface(vertices=[[0, 0, 0], [1, 0, 0], [0, 1, 0]], faces=[[0, 1, 2]])
 >>> mesh_distances(tri, np.array([[0.2, 0.2, 1.0], [2.0, 0.0, 0.0]])).tolist()
 [1.0, 1.0]
@@ -20,10 +20,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.geometry import mesh
-from geobrep.spatial_index import SpatialIndex
+from geobrep.geometry.spatial_index import SpatialIndex
 
 if TYPE_CHECKING:
-    from geobrep.entities import Surface
+    from geobrep.model.entities import Surface
 
 __all__ = ["closest_points_on_triangles", "mesh_distances"]
 

@@ -12,7 +12,7 @@ import numpy as np
 import pyvista as pv
 
 import geobrep
-from geobrep.building import build_blocks
+from geobrep.ops.building import build_blocks
 
 COLOURS = ["#e6a23c", "#f3d39b", "#6aa84f", "#b6d7a8", "#3d85c6", "#a4c8ec"]
 

@@ -13,7 +13,7 @@ import numpy as np
 
 import geobrep
 from geobrep.cli import main as cli
-from geobrep.fitting import fit
+from geobrep.ops.fitting import fit
 
 HERE = Path(__file__).resolve().parent
 EXAGGERATION = 4.0

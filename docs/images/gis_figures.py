@@ -15,7 +15,7 @@ from matplotlib.patches import PathPatch
 from matplotlib.path import Path as MplPath
 
 import geobrep
-from geobrep.map_products import block_sections, map_products
+from geobrep.gis.map_products import block_sections, map_products
 
 HERE = Path(__file__).resolve().parent
 COLOURS = {"unit 1": "#e9c46a", "unit 2": "#2a9d8f", "unit 3": "#8ab17d"}

@@ -1,6 +1,6 @@
 """The built-in block builder: automatic block topology from conformal surfaces.
 
-Registers the ``blocks`` builder (:class:`~geobrep.registry.BuilderSpec`), reached through
+Registers the ``blocks`` builder (:class:`~geobrep.host.registry.BuilderSpec`), reached through
 ``geobrep.build_blocks(scene)`` and ``geobrep blocks IN... OUT``. The method follows An, Liu and
 Wang (2012), "Automatic construction of topological relationship of 3D geological blocks based on
 stratified geological structure", taken from a plain triangle soup to validated blocks; see
@@ -14,16 +14,16 @@ from typing import TYPE_CHECKING
 from geobrep.hookspecs import hookimpl
 
 if TYPE_CHECKING:
-    from geobrep.registry import BuilderRegistry
+    from geobrep.host.registry import BuilderRegistry
 
 __all__ = ["geobrep_register_builders"]
 
 
 @hookimpl
 def geobrep_register_builders(registry: BuilderRegistry) -> None:
+    from geobrep.host.registry import BuilderSpec
     from geobrep.plugins.blocks.builder import build_blocks
     from geobrep.plugins.blocks.options import BlockBuilderOptions
-    from geobrep.registry import BuilderSpec
 
     registry.add(
         BuilderSpec(

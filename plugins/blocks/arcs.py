@@ -1,9 +1,9 @@
-"""Arcs of the builder's patch split, by the rule of :mod:`geobrep.arcs`.
+"""Arcs of the builder's patch split, by the rule of :mod:`geobrep.model.arcs`.
 
 The builder's arc edges are those of :func:`~geobrep.plugins.blocks.patches.split_patches`
 (where a surface stops, where surfaces meet, where more than two triangles meet, orientation
 seams); corners and arcs then follow the one rule geobrep uses everywhere (the GOCAD reader and
-the sample model too), written in :mod:`geobrep.arcs` and docs/concepts.md. Each arc has one
+the sample model too), written in :mod:`geobrep.model.arcs` and docs/concepts.md. Each arc has one
 direction, from its start corner to its end corner, for all patches around it — the paper's
 "arc direction consistency" holds by construction.
 """
@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.arcs import ArcChains, chain_arc_edges
+from geobrep.model.arcs import ArcChains, chain_arc_edges
 from geobrep.plugins.blocks.patches import PatchSplit
 
 __all__ = ["ArcChains", "chain_arcs"]

@@ -15,7 +15,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
+from geobrep.model.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
+from geobrep.model.scene import Group, Scene
+from geobrep.model.topology import Arc, Corner, Patch, Topology
 from geobrep.plugins.blocks.arcs import ArcChains
 from geobrep.plugins.blocks.measures import PatchMeasures
 from geobrep.plugins.blocks.patches import PatchSplit
@@ -23,8 +25,6 @@ from geobrep.plugins.blocks.radial_sort import SortedArcs
 from geobrep.plugins.blocks.soup import Soup
 from geobrep.plugins.blocks.units import block_attributes
 from geobrep.plugins.blocks.universe import Bodies
-from geobrep.scene import Group, Scene
-from geobrep.topology import Arc, Corner, Patch, Topology
 
 __all__ = ["Assembly", "assemble"]
 

@@ -18,8 +18,9 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from geobrep.entities import Surface
 from geobrep.errors import OptionsError, TopologyError
+from geobrep.model.entities import Surface
+from geobrep.model.scene import Scene
 from geobrep.plugins.blocks.arcs import ArcChains, chain_arcs
 from geobrep.plugins.blocks.assembly import assemble
 from geobrep.plugins.blocks.conformity import check_conformity
@@ -38,7 +39,6 @@ from geobrep.plugins.blocks.soup import Soup, build_soup
 from geobrep.plugins.blocks.traversal import traverse
 from geobrep.plugins.blocks.universe import find_universe
 from geobrep.plugins.blocks.validation import validate_scene
-from geobrep.scene import Scene
 
 __all__ = ["build_blocks"]
 

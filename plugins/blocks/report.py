@@ -7,7 +7,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, Field
 
 from geobrep.errors import TopologyError
-from geobrep.scene import Scene
+from geobrep.model.scene import Scene
 
 __all__ = ["REPORT_KEY", "BlockCheck", "BlockReport", "DanglingEntry", "block_report"]
 

@@ -2,7 +2,7 @@
 with a block on both sides, and the block volumes adding up to the volume inside the universe.
 
 The checks read the scene the builder wrote — its surfaces, patches and block side lists — and
-give the same answers as :meth:`~geobrep.scene.Scene.block_mesh` with ``Surface.is_closed``,
+give the same answers as :meth:`~geobrep.Scene.block_mesh` with ``Surface.is_closed``,
 ``is_consistently_oriented`` and ``volume`` for each block, in one vectorised pass over all
 blocks instead of one weld and edge sort per block:
 
@@ -24,14 +24,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.entities import Block, Surface
 from geobrep.errors import TopologyError
+from geobrep.model.entities import Block, Surface
+from geobrep.model.scene import Scene
 from geobrep.plugins.blocks.csr import concatenated_ranges
 from geobrep.plugins.blocks.measures import PatchMeasures
 from geobrep.plugins.blocks.patches import PatchSplit
 from geobrep.plugins.blocks.report import BlockCheck
 from geobrep.plugins.blocks.soup import Soup
-from geobrep.scene import Scene
 
 __all__ = ["Validation", "validate_scene"]
 

@@ -1,6 +1,6 @@
 """geobrep's built-in clippers: one per entity type, registered like any plugin's.
 
-The facade (:func:`geobrep.clipping.clip`) calls ``function(entity, plane, keep, options,
+The facade (:func:`geobrep.clip`) calls ``function(entity, plane, keep, options,
 context)``; see ``docs/clipping.md``. Each clipper lives in its own module of this package.
 """
 
@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from geobrep.hookspecs import hookimpl
 
 if TYPE_CHECKING:
-    from geobrep.registry import ClipperRegistry
+    from geobrep.host.registry import ClipperRegistry
 
 __all__ = ["geobrep_register_clippers"]
 
@@ -19,6 +19,7 @@ __all__ = ["geobrep_register_clippers"]
 @hookimpl
 def geobrep_register_clippers(registry: ClipperRegistry) -> None:
     """Register the built-in clippers (modules are imported here, on first use of a registry)."""
+    from geobrep.host.registry import ClipperSpec
     from geobrep.plugins.clip.annotations import clip_annotation
     from geobrep.plugins.clip.blocks import clip_block, section_block
     from geobrep.plugins.clip.lines import clip_polyline, section_polyline
@@ -34,7 +35,6 @@ def geobrep_register_clippers(registry: ClipperRegistry) -> None:
     from geobrep.plugins.clip.points import clip_pointset, section_pointset
     from geobrep.plugins.clip.polygons import clip_polygon, section_polygon
     from geobrep.plugins.clip.surfaces import clip_surface, section_surface
-    from geobrep.registry import ClipperSpec
 
     registry.add(
         ClipperSpec(

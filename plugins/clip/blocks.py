@@ -5,9 +5,10 @@ of its patches' faces on the kept side, oriented out of the block (a patch is fl
 block lies on its positive side); faces lying in the plane count when the block is on their kept
 side. Opposite edges cancel; the rest, merged across surfaces within the clip's tolerance, form the
 loops that the cap fills (:mod:`.caps`). The cap's triangles face out of the block; the facade
-(:mod:`geobrep.clip_topology`) turns it into a patch between the block and the universe. Caps are
-always triangulated as seen from the plane's positive side, so a block cut into two gets the same
-cap triangles in both halves (reversed), and its two parts' volumes add up to the block's.
+(:mod:`geobrep.ops.clip_topology`) turns it into a patch between the block and the universe.
+Caps are always triangulated as seen from the plane's positive side, so a block cut into two
+gets the same cap triangles in both halves (reversed), and its two parts' volumes add up to
+the block's.
 """
 
 from __future__ import annotations
@@ -17,14 +18,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.clipping import ClipContext, Keep, halves, pack_halves
-from geobrep.entities import Block, Polygon, Surface
 from geobrep.errors import TopologyError
 from geobrep.geometry import Plane, boxes_plane_side, mesh
+from geobrep.model.entities import Block, Polygon, Surface
+from geobrep.model.scene import Scene
+from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.caps import cap_rings, cap_triangles, open_boundary
 from geobrep.plugins.clip.options import ClipOptions, tolerance_of
 from geobrep.plugins.clip.surfaces import surface_cut
-from geobrep.scene import Scene
 
 __all__ = ["block_cut_edges", "clip_block", "section_block"]
 

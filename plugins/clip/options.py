@@ -6,7 +6,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from geobrep.clipping import ClipContext
+from geobrep.ops.clipping import ClipContext
 
 __all__ = [
     "AnnotationClipOptions",

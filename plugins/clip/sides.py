@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.geometry import Plane
-from geobrep.properties import Property, PropertyMap
+from geobrep.model.properties import Property, PropertyMap
 
 __all__ = [
     "NEGATIVE_BIT",

@@ -17,15 +17,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.clipping import ClipContext, Keep, halves, pack_halves
-from geobrep.entities import Polygon, PolyLine, Surface
 from geobrep.geometry import Plane, mesh
+from geobrep.model.entities import Polygon, PolyLine, Surface
+from geobrep.model.properties import Property, PropertyMap
+from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.caps import cap_rings, cap_triangles, open_boundary
 from geobrep.plugins.clip.loops import order_paths
 from geobrep.plugins.clip.options import SurfaceClipOptions, tolerance_of
 from geobrep.plugins.clip.sides import interpolate_properties, signed_distances
 from geobrep.plugins.clip.triangles import HalfMesh, InPlaneRule, TriangleCut, cut_triangles
-from geobrep.properties import Property, PropertyMap
 
 __all__ = ["SurfaceCut", "clip_surface", "section_surface", "surface_cut"]
 

@@ -1,7 +1,7 @@
 """Built-in fitters: NURBS skinning, least-squares approximation, kriging, and the hybrid workflow.
 
 Registered through ``geobrep_register_fitters`` like any third-party plugin; ``geobrep.fit(points,
-method=...)`` dispatches to them. Every fitter returns a :class:`geobrep.fitting.FitResult` with the
+method=...)`` dispatches to them. Every fitter returns a :class:`geobrep.FitResult` with the
 surface and its accuracy report. Heavy modules are imported when a fitter runs, so loading the
 plugin stays cheap.
 
@@ -16,13 +16,13 @@ from __future__ import annotations
 from typing import Any
 
 from geobrep.hookspecs import hookimpl
+from geobrep.host.registry import FitterRegistry, FitterSpec
 from geobrep.plugins.fit.options import (
     ApproximationOptions,
     HybridOptions,
     KrigingOptions,
     SkinningOptions,
 )
-from geobrep.registry import FitterRegistry, FitterSpec
 
 __all__ = ["geobrep_register_fitters"]
 

@@ -15,9 +15,9 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from geobrep.entities import NurbsSurface
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.nurbs_eval import basis_functions, basis_matrix, find_spans
+from geobrep.geometry.nurbs import basis_functions, basis_matrix, find_spans
+from geobrep.model.entities import NurbsSurface
 from geobrep.plugins.fit.knots import (
     averaged_knots,
     chord_parameters,
@@ -122,7 +122,7 @@ def surface_boundary(surface: NurbsSurface, side: Side) -> BSplineCurve:
     gap.
 
     >>> import numpy as np
-    >>> from geobrep.entities import NurbsSurface
+    >>> from geobrep.model.entities import NurbsSurface
     >>> net = np.zeros((2, 2, 3)); net[1, :, 0] = 1; net[:, 1, 1] = 1
     >>> s = NurbsSurface(degree_u=1, degree_v=1, knots_u=[0, 0, 1, 1], knots_v=[0, 0, 1, 1],
     ...                  control_points=net)

@@ -2,7 +2,7 @@
 
 Row ``i`` holds the basis functions (or a derivative of them) at data parameter ``i``; a cubic
 surface has 16 non-zeros per row, so the matrices are built straight into CSR form from the
-vectorised basis of :mod:`geobrep.nurbs_eval` without any per-point Python work.
+vectorised basis of :mod:`geobrep.geometry.nurbs` without any per-point Python work.
 
 :func:`normal_equations` goes one step further for least squares: it never forms the design
 matrix. Points are grouped by knot cell, every cell's ``(p+1)(q+1)``-square Gram block is one
@@ -20,7 +20,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from geobrep.nurbs_eval import basis_derivatives, basis_functions, find_spans
+from geobrep.geometry.nurbs import basis_derivatives, basis_functions, find_spans
 
 __all__ = ["curve_design_matrix", "normal_equations", "surface_design_matrix"]
 

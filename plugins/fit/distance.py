@@ -5,7 +5,7 @@ NURBS distances come from a closest-point projection; mesh distances are exact
 the candidate triangles, Ericson's region tests the closest point on each).
 
 >>> import numpy as np
->>> from geobrep.entities import Surface
+>>> from geobrep.model.entities import Surface
 >>> tri = Surface(vertices=[[0, 0, 0], [1, 0, 0], [0, 1, 0]], faces=[[0, 1, 2]])
 >>> surface_distances(tri, np.array([[0.2, 0.2, 1.0], [2.0, 0.0, 0.0]])).tolist()
 [1.0, 1.0]
@@ -16,8 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.entities import NurbsSurface, Surface
 from geobrep.geometry.distance import closest_points_on_triangles, mesh_distances
+from geobrep.model.entities import NurbsSurface, Surface
 from geobrep.plugins.fit.projection import project_points
 
 __all__ = ["closest_points_on_triangles", "mesh_distances", "surface_distances"]

@@ -25,7 +25,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from geobrep.errors import DegenerateGeometryError
-from geobrep.nurbs_eval import surface_derivatives
+from geobrep.geometry.nurbs import surface_derivatives
 from geobrep.plugins.fit.bending import laplacian_matrix
 
 __all__ = ["check_fold_free", "fill_net", "piecewise_linear"]

@@ -5,7 +5,7 @@ iterations, never over points. Starting parameters come from the nearest sample 
 over every knot span (a k-d tree query), or from the caller (a fitter knows its data parameters).
 
 >>> import numpy as np
->>> from geobrep.entities import NurbsSurface
+>>> from geobrep.model.entities import NurbsSurface
 >>> net = np.zeros((2, 2, 3)); net[1, :, 0] = 1; net[:, 1, 1] = 1
 >>> plate = NurbsSurface(degree_u=1, degree_v=1, knots_u=[0, 0, 1, 1], knots_v=[0, 0, 1, 1],
 ...                      control_points=net)
@@ -22,8 +22,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from geobrep.entities import NurbsSurface
-from geobrep.nurbs_eval import surface_derivatives, surface_grid, surface_points
+from geobrep.geometry.nurbs import surface_derivatives, surface_grid, surface_points
+from geobrep.model.entities import NurbsSurface
 
 __all__ = ["SurfaceArgs", "initial_parameters", "invert_planar_map", "project_points"]
 

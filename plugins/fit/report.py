@@ -17,7 +17,7 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.fitting import Deviation, FitReport, SubsetReport
+from geobrep.ops.fitting import Deviation, FitReport, SubsetReport
 
 __all__ = ["accuracy_report", "sigma"]
 
@@ -49,7 +49,7 @@ def accuracy_report(
     notes: list[str] | None = None,
     details: dict[str, object] | None = None,
 ) -> FitReport:
-    """Build a :class:`~geobrep.fitting.FitReport` from signed distances ``(n,)``.
+    """Build a :class:`~geobrep.ops.fitting.FitReport` from signed distances ``(n,)``.
 
     ``subsets`` maps a name to a boolean mask over the points; ``labels`` (optional) names the
     subset of each point in the list of largest deviations.

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.nurbs_eval import basis_matrix, surface_points
+from geobrep.geometry.nurbs import basis_matrix, surface_points
 from geobrep.plugins.fit.curves import BSplineCurve, interpolate_curve
 from geobrep.plugins.fit.knots import averaged_knots, chord_parameters, merge_knots
 

@@ -2,7 +2,7 @@
 
 Registers one builder, ``voxelize``: ``function(scene, options) -> Scene`` appends the
 :class:`~geobrep.LinearOctree` of the scene's closed bodies (blocks or closed surfaces) to the
-scene. Most callers use :func:`geobrep.voxelization.voxelize`. Heavy work is imported on first use.
+scene. Most callers use :func:`geobrep.voxelize`. Heavy work is imported on first use.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from geobrep.plugins import BuilderSpec, hookimpl
 from geobrep.plugins.voxelize.options import VoxelizeOptions
 
 if TYPE_CHECKING:
-    from geobrep.registry import BuilderRegistry
-    from geobrep.scene import Scene
+    from geobrep.host.registry import BuilderRegistry
+    from geobrep.model.scene import Scene
 
 __all__ = ["VoxelizeOptions", "geobrep_register_builders"]
 

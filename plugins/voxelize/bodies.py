@@ -7,11 +7,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.entities import Block, Entity, Surface
 from geobrep.errors import DegenerateGeometryError, OptionsError, TopologyError
 from geobrep.geometry import mesh
 from geobrep.geometry.bbox import column_extremes
-from geobrep.scene import Scene
+from geobrep.model.entities import Block, Entity, Surface
+from geobrep.model.scene import Scene
 
 __all__ = ["Body", "OctreeCube", "collect_bodies", "octree_cube"]
 

@@ -17,11 +17,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.entities import LinearOctree
 from geobrep.errors import OptionsError
 from geobrep.geometry import mesh
 from geobrep.geometry.bbox import column_extremes
 from geobrep.geometry.morton import morton_decode
+from geobrep.model.entities import LinearOctree
+from geobrep.model.scene import Scene
+from geobrep.ops.voxelization import VoxelizationWarning
 from geobrep.plugins.voxelize.bodies import Body, collect_bodies, octree_cube
 from geobrep.plugins.voxelize.classify import OctantClassifier, PriorityClassifier
 from geobrep.plugins.voxelize.depth_buffers import DepthBufferClassifier, depth_buffers
@@ -30,8 +32,6 @@ from geobrep.plugins.voxelize.merge import merge_full_siblings
 from geobrep.plugins.voxelize.options import SUB_CUBE_DEPTH, VoxelizeOptions
 from geobrep.plugins.voxelize.parity import ExactClassifier
 from geobrep.plugins.voxelize.rasterize import ray_crossings
-from geobrep.scene import Scene
-from geobrep.voxelization import VoxelizationWarning
 
 __all__ = ["BodyReport", "build_octree", "voxelize_scene"]
 

@@ -6,12 +6,12 @@ import pytest
 from blocks_models import box_model
 
 from geobrep import PointSet, Scene
-from geobrep.building import build_blocks
 from geobrep.errors import OptionsError, TopologyError
+from geobrep.host.registry import UnknownItemError
+from geobrep.ops.building import build_blocks
 from geobrep.plugins import list_plugins, registries
 from geobrep.plugins.blocks.options import BlockBuilderOptions
 from geobrep.plugins.blocks.report import REPORT_KEY, BlockReport, block_report
-from geobrep.registry import UnknownItemError
 
 
 def test_the_builder_is_registered_by_the_blocks_plugin() -> None:
@@ -67,6 +67,6 @@ def test_report_round_trips_through_the_scene_metadata() -> None:
 
 
 def test_build_blocks_is_exported_from_the_facade_module() -> None:
-    import geobrep.building
+    import geobrep.ops.building
 
-    assert geobrep.building.__all__ == ["build_blocks", "demo_stage"]
+    assert geobrep.ops.building.__all__ == ["build_blocks", "demo_stage"]

@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from geobrep import Block, Scene, Surface
-from geobrep.building import build_blocks
+from geobrep.ops.building import build_blocks
 from geobrep.plugins.blocks.report import block_report
 
 UTM = (450_000.0, 6_700_000.0, -250.0)

@@ -12,7 +12,7 @@ from blocks_models import box_model, vertical_fault
 import geobrep
 from geobrep import Block, Scene
 from geobrep.cli import main
-from geobrep.crs import CRS
+from geobrep.model.crs import CRS
 
 
 def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:

@@ -6,8 +6,8 @@ import json
 from pathlib import Path
 
 import geobrep
-from geobrep.building import demo_stage
 from geobrep.demo import DemoContext
+from geobrep.ops.building import demo_stage
 
 
 def test_demo_stage_rebuilds_the_sample(tmp_path: Path) -> None:

@@ -12,7 +12,7 @@ import pytest
 import geobrep.plugins.blocks
 
 MODULES = [
-    "geobrep.building",
+    "geobrep.ops.building",
     "geobrep.cli.blocks",
     "geobrep.plugins.blocks",
     *(

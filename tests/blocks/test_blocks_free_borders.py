@@ -7,8 +7,8 @@ import pytest
 from blocks_models import box_model, closed_cube, floating_square, vertical_fault
 
 from geobrep import Scene, Surface
-from geobrep.building import build_blocks
 from geobrep.errors import TopologyError
+from geobrep.ops.building import build_blocks
 from geobrep.plugins.blocks.report import block_report
 
 TIP = 0.75

@@ -10,7 +10,7 @@ import pytest
 
 import geobrep
 from geobrep import Block, Scene, Surface
-from geobrep.building import build_blocks
+from geobrep.ops.building import build_blocks
 from geobrep.plugins.blocks.report import block_report
 
 DATA = Path(__file__).resolve().parent.parent / "data" / "gocad"

@@ -7,7 +7,7 @@ import pytest
 
 import geobrep
 from geobrep import Block, Scene, Surface
-from geobrep.building import build_blocks
+from geobrep.ops.building import build_blocks
 from geobrep.plugins.blocks.report import block_report
 
 SignedSet = frozenset[tuple[tuple[int, int], int]]

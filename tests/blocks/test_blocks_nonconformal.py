@@ -9,8 +9,8 @@ import pytest
 from blocks_models import box_model, grid_surface, vertical_fault, wedge_model
 
 from geobrep import Scene, Surface
-from geobrep.building import build_blocks
 from geobrep.errors import TopologyError
+from geobrep.ops.building import build_blocks
 from geobrep.plugins.blocks.conformity import (
     NonConformalError,
     point_triangle_distance,

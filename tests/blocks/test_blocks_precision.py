@@ -16,8 +16,8 @@ from numpy.typing import NDArray
 
 import geobrep
 from geobrep import Scene, Surface
-from geobrep.building import build_blocks
 from geobrep.errors import TopologyError
+from geobrep.ops.building import build_blocks
 from geobrep.plugins.blocks.precision import (
     CEILING,
     FLOOR,

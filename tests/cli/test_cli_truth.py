@@ -24,8 +24,8 @@ from geobrep import Scene
 from geobrep.cli import main
 from geobrep.cli.common import EXIT_EMPTY
 from geobrep.cli.main import COMMAND_MODULES
-from geobrep.clipping import clip
 from geobrep.geometry import Plane
+from geobrep.ops.clipping import clip
 
 DATA = Path(__file__).parents[1] / "data" / "gocad"
 MODEL_A1 = DATA / "modelA1.ml"
@@ -136,7 +136,9 @@ class TestErrorsNameTheTarget:
         assert err.startswith(f"geobrep: error: {target}: a shapefile holds one layer")
         assert ".tmp-" not in err
         with pytest.raises(geobrep.FormatError) as caught:
-            geobrep.write(geobrep.clipping.section(geobrep.read(MODEL_A1), Plane.x(1000.0)), target)
+            geobrep.write(
+                geobrep.ops.clipping.section(geobrep.read(MODEL_A1), Plane.x(1000.0)), target
+            )
         assert caught.value.path == target
         assert list(tmp_path.iterdir()) == []
 

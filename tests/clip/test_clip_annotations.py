@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from geobrep import Annotation, Plane
-from geobrep.clipping import clip, clip_box
+from geobrep.ops.clipping import clip, clip_box
 from geobrep.plugins.clip.annotations import annotation_polyline
 from geobrep.plugins.clip.glyphs import GLYPHS, glyph_strokes
 

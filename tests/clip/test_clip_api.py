@@ -6,13 +6,13 @@ import pytest
 from shapes import make_cube
 
 from geobrep import Block, Plane, TetMesh
-from geobrep.clipping import box_planes, clip, clip_box, section
 from geobrep.errors import (
     DegenerateGeometryError,
     EntityValidationError,
     GeobrepError,
     OptionsError,
 )
+from geobrep.ops.clipping import box_planes, clip, clip_box, section
 from geobrep.plugins import list_plugins, registries
 
 EXPECTED = {

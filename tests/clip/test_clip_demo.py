@@ -5,9 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from geobrep import Scene
-from geobrep.clipping import demo_stage
 from geobrep.demo import DemoContext
-from geobrep.io import read
+from geobrep.ops.clipping import demo_stage
+from geobrep.ops.io import read
 
 
 def test_demo_stage(layer_cake: Scene, tmp_path: Path) -> None:

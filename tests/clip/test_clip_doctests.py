@@ -8,7 +8,7 @@ import importlib
 import pytest
 
 MODULES = [
-    "geobrep.clipping",
+    "geobrep.ops.clipping",
     "geobrep.cli.clip",
     *(
         f"geobrep.plugins.clip.{name}"

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from geobrep import Plane, PolyLine
-from geobrep.clipping import clip, section
+from geobrep.ops.clipping import clip, section
 
 
 def _parts(line: PolyLine) -> list[list[list[float]]]:

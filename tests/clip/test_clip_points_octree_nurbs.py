@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from geobrep import LinearOctree, NurbsSurface, Plane, PointSet
-from geobrep.clipping import clip, section
 from geobrep.errors import DegenerateGeometryError
+from geobrep.ops.clipping import clip, section
 from geobrep.plugins.clip.nurbs import trimmed_mesh
 
 

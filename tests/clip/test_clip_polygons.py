@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from geobrep import Plane, Polygon
-from geobrep.clipping import clip, section
+from geobrep.ops.clipping import clip, section
 
 
 def _flat(points: list[tuple[float, float]]) -> np.ndarray:

@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from geobrep import Plane, Surface
-from geobrep.clipping import clip
+from geobrep.ops.clipping import clip
 
 spherical = st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.floats(-1.0, 1.0)).filter(
     lambda v: float(np.linalg.norm(v)) > 0.05
@@ -105,7 +105,7 @@ def test_random_boxes_carve_closed_columns(
     seed: int, low: tuple[float, float, float], size: float
 ) -> None:
     """Successive cuts (cutting earlier caps, along their straight edges) stay closed."""
-    from geobrep.clipping import clip_box
+    from geobrep.ops.clipping import clip_box
 
     surface = _star(seed)
     lo = np.array(low)

@@ -7,7 +7,7 @@ import pytest
 from clip_shapes import assert_closed_half, cap_area, icosphere
 
 from geobrep import Plane, Surface
-from geobrep.clipping import clip
+from geobrep.ops.clipping import clip
 
 pv = pytest.importorskip("pyvista")
 trimesh = pytest.importorskip("trimesh")

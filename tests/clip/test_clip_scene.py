@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from geobrep import Block, Plane, Scene, Surface
-from geobrep.arcs import build_corners_and_arcs
-from geobrep.clipping import clip, clip_box, section
 from geobrep.geometry import mesh
+from geobrep.model.arcs import build_corners_and_arcs
+from geobrep.ops.clipping import clip, clip_box, section
 
 PLANES = [
     Plane.x(450_512.3),

@@ -10,8 +10,8 @@ from clip_shapes import UTM, assert_closed_half, cap_area, icosphere
 from shapes import make_cube
 
 from geobrep import Plane, Property, Surface
-from geobrep.clipping import clip
 from geobrep.errors import DegenerateGeometryError, PluginError
+from geobrep.ops.clipping import clip
 
 
 @pytest.mark.parametrize(
@@ -251,7 +251,7 @@ def test_nothing_left_is_none() -> None:
 
 
 def test_a_broken_clipper_is_reported(monkeypatch: pytest.MonkeyPatch) -> None:
-    from geobrep.clipping import _registry
+    from geobrep.ops.clipping import _registry
 
     spec = _registry().get("surface")
     monkeypatch.setattr(spec, "__dict__", {**spec.__dict__, "function": lambda *args: 42})

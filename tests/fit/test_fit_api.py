@@ -13,9 +13,9 @@ from geobrep import NurbsSurface, PointSet, Scene
 from geobrep.cli import main
 from geobrep.demo import DemoContext
 from geobrep.errors import EntityValidationError, FormatError, OptionsError, PluginError
-from geobrep.fitting import FitReport, FitResult, demo_stage, fit
+from geobrep.host.registry import UnknownItemError
+from geobrep.ops.fitting import FitReport, FitResult, demo_stage, fit
 from geobrep.plugins import FitterSpec, list_plugins, registries
-from geobrep.registry import UnknownItemError
 
 
 def test_builtin_fitters_are_registered() -> None:
@@ -82,7 +82,7 @@ def test_a_third_party_fitter_returning_a_bare_surface() -> None:
             registry.add(FitterSpec(name="corners", function=corners))
             registry.add(FitterSpec(name="broken", function=broken))
 
-    from geobrep import plugin_loader
+    from geobrep.host import loader as plugin_loader
 
     previous = plugin_loader.set_host(None)
     try:

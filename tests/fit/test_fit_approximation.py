@@ -11,7 +11,7 @@ import geobrep
 from geobrep import NurbsSurface, PointSet
 from geobrep.datasets import dome_elevation
 from geobrep.errors import DegenerateGeometryError, EntityValidationError, OptionsError
-from geobrep.fitting import fit
+from geobrep.ops.fitting import fit
 from geobrep.plugins.fit.design import normal_equations, surface_design_matrix
 from geobrep.plugins.fit.knots import uniform_knots
 from geobrep.plugins.fit.options import ApproximationOptions, BoundaryCurve

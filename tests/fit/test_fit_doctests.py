@@ -8,9 +8,9 @@ import importlib
 import pytest
 
 MODULES = [
-    "geobrep.fitting",
+    "geobrep.ops.fitting",
     "geobrep.geometry.distance",
-    "geobrep.nurbs_eval",
+    "geobrep.geometry.nurbs",
     "geobrep.plugins.fit.approximation",
     "geobrep.plugins.fit.bending",
     "geobrep.plugins.fit.curves",

@@ -10,7 +10,7 @@ import geobrep
 from geobrep import NurbsSurface, PointSet
 from geobrep.datasets import dome_elevation
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.fitting import FitResult, fit
+from geobrep.ops.fitting import FitResult, fit
 from geobrep.plugins.fit.frame import LocalFrame
 from geobrep.plugins.fit.hybrid import layout_knots
 from geobrep.plugins.fit.split import core_by_density

@@ -10,7 +10,7 @@ from scipy.spatial import cKDTree
 import geobrep
 from geobrep import Surface
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.fitting import fit
+from geobrep.ops.fitting import fit
 from geobrep.plugins.fit import kriging
 from geobrep.plugins.fit.kriging import krige
 from geobrep.plugins.fit.variogram import (

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from geobrep import NurbsSurface
 from geobrep.errors import EntityValidationError
-from geobrep.nurbs_eval import (
+from geobrep.geometry.nurbs import (
     basis_derivatives,
     basis_functions,
     basis_matrix,

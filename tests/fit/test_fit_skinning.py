@@ -8,7 +8,7 @@ import pytest
 import geobrep
 from geobrep import PointSet, PolyLine
 from geobrep.errors import DegenerateGeometryError, EntityValidationError, OptionsError
-from geobrep.fitting import fit
+from geobrep.ops.fitting import fit
 from geobrep.plugins.fit.curves import interpolate_curve, surface_boundary
 from geobrep.plugins.fit.knots import insert_knots, merge_knots, missing_knots
 from geobrep.plugins.fit.skinning import rows_from_lattice, skin_rows
@@ -152,7 +152,7 @@ class TestCurves:
         knots = np.array([0, 0, 0, 0.5, 1, 1, 1.0])
         ctrl = np.array([[0, 0], [1, 2], [2, -1], [3, 0.0]])
         new_knots, new_ctrl = insert_knots(2, knots, ctrl, np.array([0.25, 0.5, 0.75]))
-        from geobrep.nurbs_eval import basis_matrix
+        from geobrep.geometry.nurbs import basis_matrix
 
         t = np.linspace(0, 1, 50)
         np.testing.assert_allclose(

@@ -17,10 +17,10 @@ import pytest
 from numpy.typing import NDArray
 
 import geobrep
+from geobrep.batch.pipeline_run import run_pipeline
 from geobrep.cli.main import main
 from geobrep.datasets import dome_elevation, scattered_points
-from geobrep.fitting import FitReport, FitResult
-from geobrep.pipeline_run import run_pipeline
+from geobrep.ops.fitting import FitReport, FitResult
 
 FloatArray = NDArray[np.float64]
 

@@ -7,12 +7,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.capabilities import restrict_scene
 from geobrep.datasets import faulted_layer_cake
-from geobrep.entities import Entity, PointSet, PolyLine, Surface, TetMesh
-from geobrep.properties import Property
-from geobrep.registry import FormatCapabilities
-from geobrep.scene import Scene
+from geobrep.host.capabilities import restrict_scene
+from geobrep.host.registry import FormatCapabilities
+from geobrep.model.entities import Entity, PointSet, PolyLine, Surface, TetMesh
+from geobrep.model.properties import Property
+from geobrep.model.scene import Scene
 
 #: Formats the meshio, ply and pyvista adapters (and the native format) register.
 OUR_FORMATS = ("native", "vtu", "vtk", "gmsh", "obj", "stl", "off", "ply", "vtp", "csv")

@@ -18,14 +18,14 @@ from pathlib import Path
 
 import pytest
 
-from geobrep.capabilities import has_geometry
-from geobrep.conversion import convert
-from geobrep.entities import Entity
+from geobrep.batch.conversion import convert
 from geobrep.errors import GeobrepError
-from geobrep.io import read
+from geobrep.host.capabilities import has_geometry
+from geobrep.host.registry import FormatCapabilities
+from geobrep.model.entities import Entity
+from geobrep.model.scene import Scene
+from geobrep.ops.io import read
 from geobrep.plugins import registries
-from geobrep.registry import FormatCapabilities
-from geobrep.scene import Scene
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 
@@ -268,13 +268,13 @@ def test_a_group_of_voxets_only_is_an_error_not_an_unreadable_file(tmp_path: Pat
 def test_verify_fails_a_file_whose_report_hides_a_loss(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import geobrep.conversion
+    import geobrep.batch.conversion
 
     source = GOCAD / "split_cube.ml"
     honest = convert(source, tmp_path / "a.ts", verify=True).reports[0]
     assert honest.status == "converted"
     assert "3 Block entities dropped (a GOCAD TSurf file holds Surface)" in honest.lost
-    monkeypatch.setattr(geobrep.conversion, "format_losses", lambda *args: [])
+    monkeypatch.setattr(geobrep.batch.conversion, "format_losses", lambda *args: [])
     silent = convert(source, tmp_path / "b.ts").reports[0]
     assert silent.status == "converted"  # without --verify the lie goes unnoticed
     caught = convert(source, tmp_path / "c.ts", verify=True).reports[0]
@@ -292,7 +292,7 @@ def test_cli_convert_verify(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
 
 
 def test_a_pipeline_reports_what_its_reader_skipped_and_its_target_drops(tmp_path: Path) -> None:
-    from geobrep.pipeline_run import run_pipeline
+    from geobrep.batch.pipeline_run import run_pipeline
 
     pipeline = {
         "version": 1,

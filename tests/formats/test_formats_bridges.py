@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 from formats_support import rich_scene
 
+from geobrep.adapters.cell_layout import layout_to_scene, scene_to_layout
 from geobrep.adapters.meshio import bridge
-from geobrep.capabilities import restrict_scene
-from geobrep.cell_layout import layout_to_scene, scene_to_layout
-from geobrep.entities import LinearOctree, PointSet, PolyLine, Surface
 from geobrep.errors import FormatError, MissingDependencyError
-from geobrep.io import read, write
+from geobrep.host.capabilities import restrict_scene
+from geobrep.model.entities import LinearOctree, PointSet, PolyLine, Surface
+from geobrep.model.scene import Scene
+from geobrep.ops.io import read, write
 from geobrep.plugins import registries
-from geobrep.scene import Scene
 
 
 @pytest.fixture(scope="module")

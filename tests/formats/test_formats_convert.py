@@ -7,13 +7,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from geobrep.batch.conversion import ConversionSummary, convert, demo_stage, expand
 from geobrep.cli.main import main
-from geobrep.conversion import ConversionSummary, convert, demo_stage, expand
 from geobrep.demo import DemoContext
-from geobrep.entities import Surface
 from geobrep.errors import FileAccessError, OptionsError
-from geobrep.io import read, write
-from geobrep.scene import Scene
+from geobrep.model.entities import Surface
+from geobrep.model.scene import Scene
+from geobrep.ops.io import read, write
 
 BATCH = 200
 

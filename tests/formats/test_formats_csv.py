@@ -11,8 +11,8 @@ import pytest
 
 import geobrep
 from geobrep.adapters.csv.table import looks_like_points_table
-from geobrep.capabilities import capability_losses
 from geobrep.errors import FormatError
+from geobrep.host.capabilities import capability_losses
 from geobrep.plugins import registries
 
 
@@ -165,7 +165,7 @@ def test_module_examples() -> None:
 
 
 def test_a_specific_sniffer_beats_the_generic_table(tmp_path: Path) -> None:
-    from geobrep.registry import FormatRegistry, FormatSpec
+    from geobrep.host.registry import FormatRegistry, FormatSpec
 
     path = tmp_path / "survey.txt"
     path.write_text("1 2 3\n4 5 6\n")

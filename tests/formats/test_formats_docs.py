@@ -5,9 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import geobrep.plugins
-from geobrep.capabilities import capability_table
+from geobrep.host.capabilities import capability_table
+from geobrep.host.registry import FormatRegistry
 from geobrep.plugins import registries
-from geobrep.registry import FormatRegistry
 
 PAGE = Path(__file__).parents[2] / "docs" / "formats.md"
 

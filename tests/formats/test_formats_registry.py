@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 import geobrep.plugins
-from geobrep.conversion import convert
-from geobrep.entities import PointSet
+from geobrep.batch.conversion import convert
 from geobrep.errors import UnknownFormatError
-from geobrep.io import read, write
-from geobrep.plugin_loader import register_plugin, set_host
+from geobrep.host.loader import register_plugin, set_host
+from geobrep.model.entities import PointSet
+from geobrep.model.scene import Scene
+from geobrep.ops.io import read, write
 from geobrep.plugins import registries
-from geobrep.scene import Scene
 
 EXAMPLE_SRC = Path(__file__).parents[2] / "docs" / "examples" / "geobrep-example-plugin" / "src"
 

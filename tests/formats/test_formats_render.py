@@ -10,8 +10,8 @@ from numpy.typing import NDArray
 
 from geobrep.cli.main import main
 from geobrep.errors import OptionsError
-from geobrep.io import write
-from geobrep.scene import Scene
+from geobrep.model.scene import Scene
+from geobrep.ops.io import write
 
 pytest.importorskip("pyvista")
 

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from formats_support import OUR_FORMATS, assert_held_equal, merged_cells, rich_scene
 
-from geobrep.capabilities import capability_losses, restrict_scene
 from geobrep.errors import FormatError
-from geobrep.io import read, write
+from geobrep.host.capabilities import capability_losses, restrict_scene
+from geobrep.model.scene import Scene
+from geobrep.ops.io import read, write
 from geobrep.plugins import registries
-from geobrep.scene import Scene
 
 DATA = Path(__file__).parent.parent / "data" / "gocad"
 GOCAD_FILES = sorted(p.name for p in DATA.glob("*") if p.suffix != ".md")
@@ -111,7 +111,7 @@ def test_surface_formats_refuse_a_scene_without_surfaces(scene: Scene, tmp_path:
 def test_face_index_beyond_the_points_of_a_geobrep_file_is_a_format_error(
     extension: str, tmp_path: Path
 ) -> None:
-    from geobrep.entities import Surface
+    from geobrep.model.entities import Surface
 
     surface = Surface(vertices=np.eye(3), faces=[[0, 1, 2]], name="one", cell_data={"z": [7]})
     path = write(Scene(entities=[surface]), tmp_path / f"one{extension}")

@@ -12,8 +12,8 @@ import pytest
 
 import geobrep
 from geobrep.errors import OptionsError
-from geobrep.feature_tables import FeatureWarning
-from geobrep.io import read, write
+from geobrep.gis.feature_tables import FeatureWarning
+from geobrep.ops.io import read, write
 
 pytest.importorskip("pyogrio")
 

@@ -9,8 +9,8 @@ import pytest
 
 import geobrep
 from geobrep.cli.main import main
-from geobrep.crs_ops import CRSError, crs_from_user_input, describe_crs, parse_crs, to_crs
-from geobrep.io import read, write
+from geobrep.gis.crs_ops import CRSError, crs_from_user_input, describe_crs, parse_crs, to_crs
+from geobrep.ops.io import read, write
 
 pyproj = pytest.importorskip("pyproj")
 

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import geobrep
+from geobrep.batch.pipeline_run import run_pipeline
 from geobrep.cli.main import main
-from geobrep.crs_ops import CRSError, from_geodataframe, to_crs, to_geodataframe
-from geobrep.pipeline_run import run_pipeline
+from geobrep.gis.crs_ops import CRSError, from_geodataframe, to_crs, to_geodataframe
 
 pyproj = pytest.importorskip("pyproj")
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import geobrep
-from geobrep.crs_ops import from_geodataframe, to_geodataframe
-from geobrep.feature_tables import FeatureWarning
+from geobrep.gis.crs_ops import from_geodataframe, to_geodataframe
+from geobrep.gis.feature_tables import FeatureWarning
 
 geopandas = pytest.importorskip("geopandas")
 shapely = pytest.importorskip("shapely")

@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 import geobrep
-from geobrep.io import read, write
-from geobrep.map_products import (
+from geobrep.gis.map_products import (
     block_outlines,
     block_sections,
     level_set_segments,
@@ -17,6 +16,7 @@ from geobrep.map_products import (
     surface_outlines,
     top_traces,
 )
+from geobrep.ops.io import read, write
 
 shapely = pytest.importorskip("shapely")
 

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import geobrep
-from geobrep.crs_ops import crs_from_user_input
 from geobrep.errors import FormatError
-from geobrep.feature_tables import FeatureWarning
-from geobrep.io import read, write
+from geobrep.gis.crs_ops import crs_from_user_input
+from geobrep.gis.feature_tables import FeatureWarning
+from geobrep.ops.io import read, write
 
 pytest.importorskip("pyogrio")
 

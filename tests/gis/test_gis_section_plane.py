@@ -13,8 +13,8 @@ from numpy.typing import NDArray
 
 import geobrep
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.feature_tables import FeatureWarning
-from geobrep.map_products import (
+from geobrep.gis.feature_tables import FeatureWarning
+from geobrep.gis.map_products import (
     SectionFrame,
     block_sections,
     from_section_plane,
@@ -170,7 +170,7 @@ def test_geojson_and_shapefile_leave_plane_layers_out_with_a_warning(tmp_path: P
 
 
 def test_the_geopandas_bridge_keeps_plane_coordinates_apart() -> None:
-    from geobrep.crs_ops import to_geodataframe
+    from geobrep.gis.crs_ops import to_geodataframe
 
     products = map_products(CAKE, section_planes=[VERTICAL["along y"]])
     with pytest.warns(FeatureWarning, match="left out 6 entities in section-plane coordinates"):

@@ -1,4 +1,4 @@
-"""The examples in the GOCAD adapter's docstrings (and geobrep.arcs) run and give their output."""
+"""The examples in the GOCAD adapter's docstrings (and geobrep.model.arcs) run as written."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import importlib
 import pytest
 
 MODULES = [
-    "geobrep.arcs",
+    "geobrep.model.arcs",
     "geobrep.adapters.gocad.headers",
     "geobrep.adapters.gocad.lexer",
     "geobrep.adapters.gocad.numbers",

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 import geobrep
 from geobrep.adapters.gocad.parser import GocadWarning
-from geobrep.model import arrays_identical
+from geobrep.model.base import arrays_identical
 
 SMALL = [
     "2triangles.ts",

@@ -12,8 +12,8 @@ from gocad_files import DATA, FILES, read_quietly
 import geobrep
 from geobrep import Block, PointSet, PolyLine, Scene, Surface, TetMesh
 from geobrep.adapters.gocad.parser import GocadWarning
-from geobrep.arcs import build_corners_and_arcs
-from geobrep.topology import Topology
+from geobrep.model.arcs import build_corners_and_arcs
+from geobrep.model.topology import Topology
 
 #: file -> (entity type counts, total patches in the topology, blocks besides the universe)
 EXPECTED = {

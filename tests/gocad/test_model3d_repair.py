@@ -17,7 +17,7 @@ from gocad_files import DATA
 import geobrep
 from geobrep import Block, PatchSide, Scene, Surface, TopologyError
 from geobrep.geometry.mesh import flip_faces, is_consistently_oriented
-from geobrep.model_orientation import orient_blocks
+from geobrep.model.orientation import orient_blocks
 
 MODELS = sorted(p.name for p in DATA.glob("*.ml"))
 #: Models whose blocks are not closed: their volumes are not checked (the universe of

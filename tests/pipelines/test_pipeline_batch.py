@@ -10,7 +10,7 @@ import pytest
 from shapes import CUBE_FACES, CUBE_VERTICES
 
 import geobrep
-from geobrep.pipeline_run import PipelineSummary, run_pipeline
+from geobrep.batch.pipeline_run import PipelineSummary, run_pipeline
 
 FILES = 20
 ORIGIN = np.array([450_000.0, 6_700_000.0, -500.0])

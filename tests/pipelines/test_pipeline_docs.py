@@ -9,7 +9,7 @@ import jsonschema
 import yaml
 
 import geobrep.schemas
-from geobrep.pipeline import STEP_KINDS, Pipeline
+from geobrep.batch.pipeline import STEP_KINDS, Pipeline
 
 PAGE = Path(__file__).resolve().parents[2] / "docs" / "pipelines.md"
 

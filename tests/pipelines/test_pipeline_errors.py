@@ -6,9 +6,9 @@ from pathlib import Path
 
 import pytest
 
+from geobrep.batch.pipeline import Pipeline
+from geobrep.batch.pipeline_run import run_pipeline
 from geobrep.errors import FileAccessError, FormatError, OptionsError
-from geobrep.pipeline import Pipeline
-from geobrep.pipeline_run import run_pipeline
 
 
 def _load(tmp_path: Path, text: str, name: str = "pipeline.yaml") -> Pipeline:

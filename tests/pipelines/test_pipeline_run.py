@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 import geobrep
+from geobrep.batch.pipeline import Pipeline, VoxelizeStep, WriteStep
+from geobrep.batch.pipeline_run import run_pipeline
 from geobrep.datasets.scattered import dome_elevation
-from geobrep.entities import LinearOctree, NurbsSurface, Surface
-from geobrep.pipeline import Pipeline, VoxelizeStep, WriteStep
-from geobrep.pipeline_run import run_pipeline
+from geobrep.model.entities import LinearOctree, NurbsSurface, Surface
 
 #: The layer cake is 1000 × 800 × 600 m; folding moves columns vertically, keeping volumes.
 WEST_VOLUME = 500.0 * 800.0 * 600.0

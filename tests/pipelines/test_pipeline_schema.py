@@ -9,8 +9,8 @@ import jsonschema
 import pytest
 
 import geobrep.schemas
+from geobrep.batch.pipeline import STEP_KINDS, Pipeline
 from geobrep.errors import OptionsError
-from geobrep.pipeline import STEP_KINDS, Pipeline
 
 FULL: dict[str, Any] = {
     "version": 1,

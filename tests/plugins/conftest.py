@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from geobrep import plugin_loader
-from geobrep.plugin_loader import DISABLE_ENV, ENTRY_POINT_GROUP, STRICT_ENV
+from geobrep.host import loader as plugin_loader
+from geobrep.host.loader import DISABLE_ENV, ENTRY_POINT_GROUP, STRICT_ENV
 
 FAKE_PLUGINS = Path(__file__).parent / "fake_plugins"
 REPO = Path(__file__).resolve().parents[2]

@@ -11,8 +11,8 @@ import pytest
 
 import geobrep.plugins
 from geobrep.errors import FormatError, OptionsError
-from geobrep.plugin_loader import DISABLE_ENV
-from geobrep.registry import FormatSpec
+from geobrep.host.loader import DISABLE_ENV
+from geobrep.host.registry import FormatSpec
 
 
 def xyz_format() -> FormatSpec:
@@ -113,7 +113,7 @@ def test_bad_line_is_a_format_error_with_line_number(example_plugin: Path, tmp_p
         spec.reader(path, spec.validate_options())
 
 
-# The two tests below use geobrep's entities (PointSet, Scene) and geobrep.io.atomic_write.
+# The two tests below use geobrep's entities (PointSet, Scene) and geobrep.ops.io.atomic_write.
 
 
 def test_read_xyz_into_a_point_set(example_plugin: Path, tmp_path: Path) -> None:

@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 
 from geobrep.hookspecs import GeobrepSpecs
-from geobrep.plugin_loader import HOOK_KINDS
+from geobrep.host.loader import HOOK_KINDS
 
 GUIDE = Path(__file__).resolve().parents[2] / "docs" / "plugin-guide.md"
 

@@ -13,10 +13,10 @@ from pathlib import Path
 import pytest
 
 import geobrep.plugins
-from geobrep import plugin_loader
 from geobrep.errors import PluginError
 from geobrep.hookspecs import GeobrepSpecs
-from geobrep.plugin_loader import (
+from geobrep.host import loader as plugin_loader
+from geobrep.host.loader import (
     DISABLE_ENV,
     ENTRY_POINT_GROUP,
     HOOK_KINDS,
@@ -26,8 +26,8 @@ from geobrep.plugin_loader import (
     discover_entry_points,
     get_host,
 )
+from geobrep.host.registry import FitterRegistry, FormatRegistry, GeobrepPluginWarning, Registries
 from geobrep.plugins import FitterSpec, FormatSpec, hookimpl
-from geobrep.registry import FitterRegistry, FormatRegistry, GeobrepPluginWarning, Registries
 
 SetEntryPoints = Callable[..., list[EntryPoint]]  # the fake_entry_points fixture
 

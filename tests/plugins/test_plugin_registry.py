@@ -9,7 +9,7 @@ import pytest
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from geobrep.errors import GeobrepError, OptionsError, PluginError, UnknownFormatError
-from geobrep.registry import (
+from geobrep.host.registry import (
     SNIFF_BYTES,
     BuilderSpec,
     ClipperRegistry,

@@ -10,7 +10,7 @@ import voxel_bodies as vb
 from test_voxelize_structure import centres, inside_truth
 
 from geobrep import Surface
-from geobrep.voxelization import VoxelizationWarning, voxelize
+from geobrep.ops.voxelization import VoxelizationWarning, voxelize
 
 DEPTH = 5
 

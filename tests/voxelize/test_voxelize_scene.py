@@ -10,8 +10,8 @@ from shapes import winding_numbers
 import geobrep.plugins
 from geobrep import LinearOctree, Scene, Surface
 from geobrep.errors import EntityNotFoundError, OptionsError, TopologyError
-from geobrep.io import read, write
-from geobrep.voxelization import voxelize
+from geobrep.ops.io import read, write
+from geobrep.ops.voxelization import voxelize
 
 DEPTH = 6
 

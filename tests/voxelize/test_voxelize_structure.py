@@ -12,13 +12,13 @@ from shapes import winding_numbers
 
 from geobrep import LinearOctree, Surface
 from geobrep.geometry.morton import morton_decode, morton_encode
+from geobrep.ops.voxelization import voxelize
 from geobrep.plugins.voxelize.classify import PriorityClassifier
 from geobrep.plugins.voxelize.depth_buffers import DepthBufferClassifier, depth_buffers
 from geobrep.plugins.voxelize.emission import Leaves, emit_leaves
 from geobrep.plugins.voxelize.merge import merge_full_siblings
 from geobrep.plugins.voxelize.parity import ExactClassifier
 from geobrep.plugins.voxelize.rasterize import ray_crossings
-from geobrep.voxelization import voxelize
 
 DEPTH = 5
 

@@ -8,8 +8,8 @@ import voxel_bodies as vb
 from hypothesis import given
 from hypothesis import strategies as st
 
+from geobrep.ops.voxelization import voxelize
 from geobrep.plugins.voxelize.rasterize import ray_crossings
-from geobrep.voxelization import voxelize
 
 
 def all_counts(vertices: np.ndarray, faces: np.ndarray, resolution: int) -> list[np.ndarray]:

@@ -9,7 +9,7 @@ import pytest
 import voxel_bodies as vb
 
 from geobrep import Surface
-from geobrep.voxelization import VoxelizationWarning, voxelize
+from geobrep.ops.voxelization import VoxelizationWarning, voxelize
 
 RADII = (1.3, 0.8, 0.5)
 SHIFT = np.array([450_000.0, 6_700_000.0, -1_200.0])

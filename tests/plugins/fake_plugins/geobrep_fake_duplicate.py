@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from geobrep.host.registry import FormatRegistry
 from geobrep.plugins import FormatSpec, hookimpl
-from geobrep.registry import FormatRegistry
 
 
 @hookimpl

@@ -5,8 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from geobrep.host.registry import ClipperRegistry, FormatRegistry
 from geobrep.plugins import ClipperSpec, FormatSpec, hookimpl
-from geobrep.registry import ClipperRegistry, FormatRegistry
 
 
 def read(path: Path, options: Any) -> str:

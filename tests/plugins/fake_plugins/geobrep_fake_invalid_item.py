@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from geobrep.host.registry import FitterRegistry
 from geobrep.plugins import FitterSpec, hookimpl
-from geobrep.registry import FitterRegistry
 
 
 @hookimpl

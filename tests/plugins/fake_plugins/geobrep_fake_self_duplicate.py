@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from geobrep.host.registry import BuilderRegistry
 from geobrep.plugins import BuilderSpec, hookimpl
-from geobrep.registry import BuilderRegistry
 
 
 @hookimpl

@@ -137,7 +137,7 @@ def write_xyz(scene: Scene, path: Path, options: XyzOptions) -> None:
     point-data properties are not stored by this format.
     """
     from geobrep import PointSet
-    from geobrep.io import atomic_write
+    from geobrep.ops.io import atomic_write
 
     entities = tuple(scene.entities)
     point_sets = [entity for entity in entities if isinstance(entity, PointSet)]

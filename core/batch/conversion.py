@@ -1,0 +1,478 @@
+"""Format conversion for one file or thousands: honest about losses, isolated per file.
+
+:func:`convert` reads each input through the format registry, writes it in the target format
+(atomically: a failure never leaves a partial file) and returns a :class:`ConversionSummary`
+with one :class:`FileReport` per input: what the target format could not hold (from its
+:class:`~geobrep.host.registry.FormatCapabilities`), or why the file failed. A corrupt file fails
+alone; the rest are converted. ``jobs=N`` converts in N processes; ``client=`` runs the same
+per-file work on a Dask cluster (a ``dask.distributed.Client`` or a scheduler address).
+
+>>> import geobrep, tempfile, pathlib
+>>> folder = pathlib.Path(tempfile.mkdtemp())
+>>> source = geobrep.write(geobrep.datasets.faulted_layer_cake(), folder / "cake.geobrep")
+>>> summary = convert(source, folder / "cake.ply")
+>>> summary.ok, summary.reports[0].lost[0]
+(True, '7 Block entities dropped (format holds PointSet, PolyLine, Surface)')
+"""
+
+from __future__ import annotations
+
+import glob
+import importlib
+import re
+import time
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from os import PathLike
+from pathlib import Path
+from typing import Any, Literal, TypeVar
+
+from pydantic import BaseModel, ConfigDict
+
+from geobrep.errors import FileAccessError, FormatError, GeobrepError, OptionsError
+from geobrep.host.capabilities import (
+    format_losses,
+    has_geometry,
+    restrict_scene,
+    without_read_losses,
+)
+from geobrep.host.registry import FormatCapabilities
+from geobrep.model.scene import Scene
+from geobrep.ops.io import read, write
+
+__all__ = [
+    "ConversionSummary",
+    "FileReport",
+    "convert",
+    "convert_file",
+    "demo_stage",
+    "expand",
+    "run_each",
+    "verify_read_back",
+]
+
+PathArg = str | PathLike[str]
+Progress = Callable[["FileReport", int, int], None]
+R = TypeVar("R")
+
+
+class FileReport(BaseModel):
+    """The outcome of converting one file."""
+
+    model_config = ConfigDict(frozen=True)
+
+    source: Path
+    target: Path | None = None
+    status: Literal["converted", "failed"]
+    lost: tuple[str, ...] = ()
+    """What the target format could not hold (empty: nothing was dropped)."""
+    error: str | None = None
+    entities: int = 0
+    seconds: float = 0.0
+
+
+class ConversionSummary(BaseModel):
+    """Every file's report, in input order."""
+
+    model_config = ConfigDict(frozen=True)
+
+    reports: tuple[FileReport, ...]
+
+    @property
+    def ok(self) -> bool:
+        """True when every file converted."""
+        return all(r.status == "converted" for r in self.reports)
+
+    @property
+    def failed(self) -> tuple[FileReport, ...]:
+        """The reports of the files that failed."""
+        return tuple(r for r in self.reports if r.status == "failed")
+
+    @property
+    def converted(self) -> tuple[FileReport, ...]:
+        """The reports of the files written."""
+        return tuple(r for r in self.reports if r.status == "converted")
+
+    def table(self) -> str:
+        """A plain-text table: one row per file, then the totals.
+
+        >>> ConversionSummary(reports=()).table().splitlines()[-1]
+        '0 converted, 0 failed'
+        """
+        rows = [("status", "source", "target", "notes")]
+        for r in self.reports:
+            notes = r.error if r.error else ("; ".join(r.lost) or "nothing lost")
+            rows.append((r.status, str(r.source), str(r.target or "-"), notes or ""))
+        return report_table(rows, f"{len(self.converted)} converted, {len(self.failed)} failed")
+
+
+def report_table(rows: Sequence[tuple[str, str, str, str]], totals: str) -> str:
+    """Rows of four cells as aligned text (the last cell free-form), then a totals line."""
+    widths = [max(len(row[i]) for row in rows) for i in range(3)]
+    lines = [
+        "  ".join(cell.ljust(width) for cell, width in zip(row[:3], widths, strict=True))
+        + "  "
+        + row[3]
+        for row in rows
+    ]
+    return "\n".join([*lines, totals])
+
+
+def expand(inputs: PathArg | Iterable[PathArg]) -> list[Path]:
+    """Paths from paths and glob patterns, in the order given (each pattern sorted).
+
+    A pattern matching nothing stays as given, so it is reported as a missing file.
+    """
+    items = [inputs] if isinstance(inputs, str | PathLike) else list(inputs)
+    paths: list[Path] = []
+    for item in items:
+        text = str(item)
+        if glob.has_magic(text):
+            matches = sorted(glob.glob(text, recursive=True))
+            paths.extend(Path(m) for m in matches) if matches else paths.append(Path(text))
+        else:
+            paths.append(Path(text))
+    return paths
+
+
+def convert_file(
+    source: Path,
+    target: Path,
+    read_format: str | None = None,
+    write_format: str | None = None,
+    write_options: dict[str, Any] | None = None,
+    verify: bool = False,
+) -> FileReport:
+    """Convert one file; never raises: a failure is a report with ``error`` set.
+
+    ``verify`` reads the written file back: anything missing that the report does not list
+    as lost makes the file fail.
+    """
+    started = time.perf_counter()
+    try:
+        from geobrep.plugins import registries
+
+        scene = read(source, format=read_format)
+        spec = registries().formats.choose_writer(target, write_format)
+        lost = format_losses(scene, spec, target)
+        scene = without_read_losses(scene)  # it describes the source, not what is written
+        write(scene, target, format=spec.name, **(write_options or {}))
+        if verify:
+            try:
+                back = read(target, format=spec.name)
+            except GeobrepError as exc:
+                raise FormatError(f"verify: the written file cannot be read back: {exc}") from exc
+            problems = verify_read_back(scene, back, spec.capabilities, lost)
+            if problems:
+                raise FormatError(
+                    f"verify: {target.name} read back differs from the report: "
+                    + "; ".join(problems[:5])
+                    + (f" (and {len(problems) - 5} more)" if len(problems) > 5 else "")
+                )
+    except GeobrepError as exc:
+        return _failed(source, target, str(exc), started)
+    except Exception as exc:  # a bug or a library failure: still this file's problem only
+        return _failed(source, target, f"{type(exc).__name__}: {exc}", started)
+    return FileReport(
+        source=source,
+        target=target,
+        status="converted",
+        lost=tuple(lost),
+        entities=len(scene.entities),
+        seconds=time.perf_counter() - started,
+    )
+
+
+def verify_read_back(
+    written: Scene, back: Scene, caps: FormatCapabilities, lost: Sequence[str]
+) -> list[str]:
+    """What ``back`` (a file read back) lacks of ``written`` that ``lost`` does not explain.
+
+    Compared, as far as ``caps`` holds them: the entities of each type, and per entity its
+    vertex and cell counts, name, id and property names. Empty when the report is true.
+
+    >>> import geobrep
+    >>> scene = geobrep.datasets.faulted_layer_cake()
+    >>> caps = geobrep.plugins.registries().formats.get("native").capabilities
+    >>> verify_read_back(scene, scene, caps, [])
+    []
+    """
+    kept = restrict_scene(written, caps).entities
+    dropped = {
+        match.group(1)
+        for sentence in lost
+        if (match := re.match(r"\d+ (\w+) entities dropped", sentence)) is not None
+    }
+    kept = tuple(e for e in kept if e.type not in dropped)
+    problems: list[str] = []
+    merged = len(kept) > 1 and not caps.multiple_entities
+    if merged:
+        if len(back.entities) != 1:
+            problems.append(f"{len(kept)} entities merged into one: {len(back.entities)} read")
+        return problems
+    for type_name in sorted({e.type for e in kept} | {e.type for e in back.entities}):
+        want = [e for e in kept if e.type == type_name]
+        got = [e for e in back.entities if e.type == type_name]
+        if len(want) != len(got):
+            problems.append(f"{len(got)} {type_name} entities read, {len(want)} written")
+            continue
+        for entity, other in zip(want, got, strict=True):
+            problems.extend(_entity_problems(entity, other, caps, lost))
+    return problems
+
+
+def _entity_problems(
+    entity: Any, other: Any, caps: FormatCapabilities, lost: Sequence[str]
+) -> list[str]:
+    where = entity.label
+    problems = []
+    if has_geometry(entity) or has_geometry(other):
+        if other.n_points != entity.n_points:
+            problems.append(f"{where}: {other.n_points} points read, {entity.n_points} written")
+        if other.n_cells != entity.n_cells:
+            problems.append(f"{where}: {other.n_cells} cells read, {entity.n_cells} written")
+    if caps.names and other.name != entity.name:
+        problems.append(f"{where}: read back named {other.name!r}")
+    if caps.ids and other.id != entity.id:
+        problems.append(f"{where}: read back with id {other.id}")
+    for field, able in (("point_data", caps.point_data), ("cell_data", caps.cell_data)):
+        missing = sorted(
+            name
+            for name in set(getattr(entity, field)) - set(getattr(other, field))
+            if not any(name in sentence for sentence in lost)  # reported: renamed, split
+        )
+        if able and missing:
+            problems.append(f"{where}: {field} {', '.join(missing)} not read back")
+    return problems
+
+
+def _failed(source: Path, target: Path | None, error: str, started: float) -> FileReport:
+    return FileReport(
+        source=source,
+        target=target,
+        status="failed",
+        error=error,
+        seconds=time.perf_counter() - started,
+    )
+
+
+def _targets(
+    sources: Sequence[Path],
+    output: Path | None,
+    to: str | None,
+    out_dir: Path | None,
+) -> list[Path | None]:
+    """Where each source goes; None for a source whose name clashes with an earlier one."""
+    if out_dir is None and output is not None and (to is not None or output.is_dir()):
+        out_dir = output
+        output = None
+    if output is not None:
+        if len(sources) != 1:
+            raise OptionsError(
+                f"{len(sources)} inputs need an output folder (out_dir=...) and a format (to=...)"
+            )
+        return [output]
+    if out_dir is None:
+        raise OptionsError("give an output file, or out_dir=... with to=... for many files")
+    if to is None:
+        raise OptionsError("converting into a folder needs the target format: to='vtu'")
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FileAccessError(
+            f"cannot create the output folder ({exc.strerror or exc})", out_dir
+        ) from exc
+    from geobrep.plugins import registries
+
+    formats = registries().formats
+    if to in formats:  # a format name: its first extension
+        spec = formats.get(to)
+        extension = spec.extensions[0] if spec.extensions else f".{spec.name}"
+    else:  # an extension (`ml`, `.vtu`): kept as given, so `ml` writes a Model3d, not a TSurf
+        extension = "." + to.lstrip(".").lower()
+        formats.choose_writer(Path(f"x{extension}"))
+    targets: list[Path | None] = []
+    seen: set[Path] = set()
+    for source in sources:
+        target = out_dir / (source.name.split(".")[0] + extension)
+        targets.append(None if target in seen else target)
+        seen.add(target)
+    return targets
+
+
+def convert(
+    inputs: PathArg | Iterable[PathArg],
+    output: PathArg | None = None,
+    *,
+    to: str | None = None,
+    out_dir: PathArg | None = None,
+    jobs: int = 1,
+    client: Any = None,
+    read_format: str | None = None,
+    write_options: dict[str, Any] | None = None,
+    progress: Progress | None = None,
+    verify: bool = False,
+) -> ConversionSummary:
+    """Convert files; returns the per-file reports (it never stops at a bad file).
+
+    ``convert("in.ts", "out.vtu")`` converts one file; ``convert(["a/*.ts"], out_dir="out",
+    to="vtu", jobs=4)`` converts many (paths or glob patterns), each to ``out/<stem>.vtu``.
+    ``to`` names a registered format (or an extension); ``jobs`` runs that many worker
+    processes; ``client`` (a ``dask.distributed.Client`` or a scheduler address such as
+    ``"tcp://scheduler:8786"``) runs the files on a Dask cluster instead. ``progress(report,
+    done, total)`` is called as each file finishes. ``verify=True`` reads each written file
+    back and fails the file when something is missing that its report does not list as lost
+    (see :func:`verify_read_back`).
+
+    Raises:
+        OptionsError: contradictory arguments (several inputs and one output file, no format).
+    """
+    if jobs < 1:
+        raise OptionsError(f"jobs must be at least 1, got {jobs}")
+    sources = expand(inputs)
+    target_dir = None if out_dir is None else Path(out_dir)
+    targets = _targets(sources, None if output is None else Path(output), to, target_dir)
+    write_format = None
+    if to is not None:
+        from geobrep.plugins import registries
+
+        formats = registries().formats
+        write_format = to if to in formats else None
+    work = [(s, t) for s, t in zip(sources, targets, strict=True) if t is not None]
+    results: dict[int, FileReport] = {}
+    total = len(sources)
+    for index, (source, target) in enumerate(zip(sources, targets, strict=True)):
+        if target is None:
+            results[index] = _failed(source, None, "another input has the same output name", 0.0)
+
+    def done(index: int, report: FileReport) -> None:
+        results[index] = report
+        if progress is not None:
+            progress(report, len(results), total)
+
+    indices = [i for i, t in enumerate(targets) if t is not None]
+    arguments = [(s, t, read_format, write_format, write_options, verify) for s, t in work]
+
+    def finished(position: int, report: FileReport | None, error: BaseException | None) -> None:
+        if report is None:  # the worker died (killed, out of memory)
+            source, target = arguments[position][:2]
+            report = _failed(source, target, f"worker failed: {type(error).__name__}", 0.0)
+        done(indices[position], report)
+
+    run_each(convert_file, arguments, finished, jobs=jobs if len(work) > 1 else 1, client=client)
+    return ConversionSummary(reports=tuple(results[i] for i in range(total)))
+
+
+def run_each(
+    function: Callable[..., R],
+    arguments: Sequence[tuple[Any, ...]],
+    done: Callable[[int, R | None, BaseException | None], None],
+    *,
+    jobs: int = 1,
+    client: Any = None,
+) -> None:
+    """Call ``function(*args)`` for every tuple of ``arguments``: here, in processes, or on Dask.
+
+    ``jobs > 1`` runs that many worker processes; ``client`` (a ``dask.distributed.Client`` or
+    a scheduler address) runs the calls on a Dask cluster. ``done(position, result, None)`` is
+    called as each call finishes, in completion order; ``done(position, None, error)`` when a
+    worker died under it. ``function`` should not raise: in this process an exception
+    propagates. Shared by :func:`convert` and :func:`geobrep.batch.pipeline_run.run_pipeline`.
+    """
+    if client is not None:
+        _run_dask(client, function, arguments, done)
+    elif jobs > 1 and len(arguments) > 1:
+        _run_processes(jobs, function, arguments, done)
+    else:
+        for position, args in enumerate(arguments):
+            done(position, function(*args), None)
+
+
+def _run_processes(
+    jobs: int,
+    function: Callable[..., R],
+    arguments: Sequence[tuple[Any, ...]],
+    done: Callable[[int, R | None, BaseException | None], None],
+) -> None:
+    with ProcessPoolExecutor(max_workers=jobs) as pool:
+        futures = {
+            pool.submit(function, *args): position for position, args in enumerate(arguments)
+        }
+        for future in as_completed(futures):
+            position = futures[future]
+            try:
+                result = future.result()
+            except Exception as exc:  # the worker process died (e.g. killed, out of memory)
+                done(position, None, exc)
+            else:
+                done(position, result, None)
+
+
+def _run_dask(
+    client: Any,
+    function: Callable[..., R],
+    arguments: Sequence[tuple[Any, ...]],
+    done: Callable[[int, R | None, BaseException | None], None],
+) -> None:
+    try:
+        distributed = importlib.import_module("distributed")
+    except ImportError as exc:
+        from geobrep.errors import MissingDependencyError
+
+        raise MissingDependencyError("distributed", "dask", "running on a Dask cluster") from exc
+    own = isinstance(client, str)
+    active = distributed.Client(client) if own else client
+    try:
+        futures = {
+            active.submit(function, *args, pure=False): position
+            for position, args in enumerate(arguments)
+        }
+        for future in distributed.as_completed(list(futures)):
+            position = futures[future]
+            try:
+                result = future.result()
+            except Exception as exc:  # the worker died
+                done(position, None, exc)
+            else:
+                done(position, result, None)
+    finally:
+        if own:
+            active.close()
+
+
+def demo_stage(ctx: Any) -> None:
+    """Demo: a picture of the model, and the model converted to .vtu and .ply."""
+    from geobrep.plugins import registries
+
+    formats = registries().formats
+    section: dict[str, Any] = {}
+    source = ctx.output / "conversion_source.geobrep"
+    write(ctx.scene, source, format="native")
+    for name, file_name in (("vtu", "layer_cake.vtu"), ("ply", "layer_cake.ply")):
+        if name not in formats:
+            section[name] = {"status": "skipped", "reason": f"format {name!r} not installed"}
+            ctx.lines.append(f"convert: {name} skipped (format not installed)")
+            continue
+        report = convert(source, ctx.output / file_name).reports[0]
+        section[name] = report.model_dump(mode="json")
+        kept = len(read(ctx.output / file_name).entities) if report.status == "converted" else 0
+        lost = "; ".join(report.lost) or "nothing"
+        ctx.lines.append(
+            f"convert: {file_name}: {report.status}, {kept} entities kept; lost: {lost}"
+            if report.status == "converted"
+            else f"convert: {file_name}: failed: {report.error}"
+        )
+    source.unlink()
+    picture = ctx.output / "layer_cake.png"
+    if "png" in formats:
+        try:
+            write(ctx.scene, picture, format="png", color_by="block")
+            section["picture"] = str(picture.name)
+            ctx.lines.append(f"render: {picture.name} (coloured by block)")
+        except GeobrepError as exc:
+            section["picture"] = None
+            ctx.lines.append(f"render: skipped ({exc})")
+    else:
+        section["picture"] = None
+        ctx.lines.append("render: skipped (install geobrep[viz] for pictures)")
+    ctx.summary["conversion"] = section

@@ -1,0 +1,686 @@
+"""Pipeline files: a list of steps (read, clip, fit, build blocks, voxelize, write, ...) per input.
+
+A pipeline is a YAML or JSON document validated by :class:`Pipeline` (its JSON Schema is
+``schemas/pipeline.schema.json``)::
+
+    version: 1
+    inputs: ["models/*.ml"]          # paths or globs, relative to the pipeline file
+    output: out                      # the output folder, relative to the pipeline file
+    steps:
+      - read: {format: gocad}
+      - clip: {plane: [1, 0, 0, -450500], keep: negative}
+      - voxelize: {depth: 7}
+      - write: {format: native, name: "{stem}_west.geobrep"}
+
+Every step is a mapping with one key, the step kind (:data:`STEP_KINDS`). Formats, clippers,
+fitters and builders are looked up in the plugin registries and their options validated by the
+plugin's own options model by :meth:`Pipeline.check`, before any file is touched: a typo fails
+at once, naming the step (counted from 1), its kind and the option. Running is done by
+:func:`geobrep.batch.pipeline_run.run_pipeline`.
+
+>>> pipeline = Pipeline.from_data({"inputs": ["a.geobrep"], "steps": [
+...     {"clip": {"plane": [1, 0, 0, -450500]}}, {"write": {"format": "vtu"}}]})
+>>> [step.kind for step in pipeline.step_list]
+['clip', 'write']
+>>> Pipeline.from_data({"steps": [{"clipp": {}}]})
+Traceback (most recent call last):
+...
+geobrep.errors.OptionsError: pipeline: step 1: unknown step kind 'clipp'; step kinds: read, reproject, clip, clip_box, section, fit, build_blocks, build, voxelize, write, convert
+"""  # noqa: E501
+
+from __future__ import annotations
+
+import json
+import string
+from collections.abc import Mapping
+from os import PathLike
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal, Union
+
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Discriminator,
+    Field,
+    FiniteFloat,
+    JsonValue,
+    NonNegativeFloat,
+    PrivateAttr,
+    Tag,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+
+from geobrep.errors import FileAccessError, FormatError, GeobrepError, OptionsError
+
+if TYPE_CHECKING:
+    from geobrep.host.registry import Registries
+
+__all__ = [
+    "NAME_FIELDS",
+    "STEP_KINDS",
+    "BuildBlocksStep",
+    "BuildStep",
+    "ClipBoxStep",
+    "ClipStep",
+    "ConvertStep",
+    "FitStep",
+    "Pipeline",
+    "ReadStep",
+    "ReprojectStep",
+    "SectionStep",
+    "StepOptions",
+    "VoxelizeStep",
+    "WriteStep",
+    "option_names",
+]
+
+PathArg = str | PathLike[str]
+Plane4 = tuple[FiniteFloat, FiniteFloat, FiniteFloat, FiniteFloat]
+Bounds6 = tuple[FiniteFloat, FiniteFloat, FiniteFloat, FiniteFloat, FiniteFloat, FiniteFloat]
+Options = dict[str, JsonValue]
+
+#: Fields a write step's ``name`` pattern may use.
+NAME_FIELDS = ("stem", "name", "ext", "index")
+
+
+class StepOptions(BaseModel):
+    """What every step body shares: unknown keys are errors; ``kind`` is the step's key."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+    kind: ClassVar[str] = ""
+
+    def check(self, registries: Registries) -> None:
+        """Resolve plugin items and validate their options (raises OptionsError)."""
+
+
+class ReadStep(StepOptions):
+    """Read the input file: ``format`` names a registered format (default: from the extension
+    and content; points tables ``.csv``/``.xyz``/``.txt``/``.dat`` are the ``csv`` format);
+    ``options`` are that format's options. Optional; if present, first."""
+
+    kind: ClassVar[str] = "read"
+
+    format: str | None = None
+    options: Options = Field(default_factory=dict)
+
+    def check(self, registries: Registries) -> None:
+        if self.format is None:
+            if self.options:
+                raise OptionsError("options need a format name (options belong to one format)")
+            return
+        spec = _get(registries.formats, self.format)
+        if not spec.can_read:
+            raise OptionsError(
+                f"format {self.format!r} cannot read; formats that can: "
+                + ", ".join(s.name for s in registries.formats.readers())
+            )
+        spec.validate_options(self.options)
+
+
+class ReprojectStep(StepOptions):
+    """Transform every entity into the CRS ``to`` (EPSG:xxxx or an EPSG code, WKT, PROJ);
+    ``from`` overrides (or supplies) the CRS of the input."""
+
+    model_config = ConfigDict(populate_by_name=True)
+
+    kind: ClassVar[str] = "reproject"
+
+    to: str | int
+    source: str | int | None = Field(default=None, alias="from")
+
+    def check(self, registries: Registries) -> None:
+        from geobrep.gis.crs_ops import crs_from_user_input
+
+        for label, value in (("to", self.to), ("from", self.source)):
+            if value is not None:
+                try:
+                    crs_from_user_input(value)
+                except GeobrepError as exc:
+                    raise OptionsError(f"option {label!r}: {exc}") from exc
+
+
+class _CutStep(StepOptions):
+    tolerance: NonNegativeFloat | None = None
+    """On-plane distance (default: 1e-9 × the diagonal of the scene's bounding box)."""
+    options: dict[str, Options] = Field(default_factory=dict)
+    """Options per clipper name, e.g. ``{annotation: {precision: stroke}}``."""
+    clippers: dict[str, str] = Field(default_factory=dict)
+    """The clipper to use per entity type, when several are registered."""
+
+    def check(self, registries: Registries) -> None:
+        clippers = registries.clippers
+        for name, options in self.options.items():
+            _get(clippers, name, "options").validate_options(options)
+        for entity_type, name in self.clippers.items():
+            spec = _get(clippers, name, "clippers")
+            if spec.entity_type != entity_type:
+                raise OptionsError(
+                    f"option 'clippers': clipper {name!r} cuts {spec.entity_type}, "
+                    f"not {entity_type}"
+                )
+
+
+class ClipStep(_CutStep):
+    """Cut by ``plane`` ``[a, b, c, d]`` and keep one side: ``negative`` (a·x+b·y+c·z+d < 0)
+    or ``positive``. Cut blocks are closed again by caps."""
+
+    kind: ClassVar[str] = "clip"
+
+    plane: Plane4
+    keep: Literal["negative", "positive"] = "negative"
+
+
+class ClipBoxStep(_CutStep):
+    """Keep the inside of the box ``bounds`` ``[xmin, xmax, ymin, ymax, zmin, zmax]``, or of
+    convex ``planes`` (normals pointing out)."""
+
+    kind: ClassVar[str] = "clip_box"
+
+    bounds: Bounds6 | None = None
+    planes: tuple[Plane4, ...] | None = Field(default=None, min_length=1)
+
+    @model_validator(mode="after")
+    def _one_region(self) -> ClipBoxStep:
+        if (self.bounds is None) == (self.planes is None):
+            raise ValueError("give either bounds [xmin, xmax, ymin, ymax, zmin, zmax] or planes")
+        if self.bounds is not None:
+            xmin, xmax, ymin, ymax, zmin, zmax = self.bounds
+            if not (xmin <= xmax and ymin <= ymax and zmin <= zmax):
+                raise ValueError(
+                    f"bounds: expected xmin ≤ xmax, ymin ≤ ymax, zmin ≤ zmax: {list(self.bounds)}"
+                )
+        return self
+
+
+class SectionStep(_CutStep):
+    """Replace the scene by its section on ``plane``: a polygon per cut block, a trace line per
+    cut surface (a fence-diagram panel; GeoPackage/GeoJSON layers hold it)."""
+
+    kind: ClassVar[str] = "section"
+
+    plane: Plane4
+
+
+class FitStep(StepOptions):
+    """Fit a surface to each PointSet (or to the entities named in ``points``) with the
+    fitter ``method``; ``options`` are the fitter's (e.g. ``epsilon``). The scene becomes the
+    fitted surfaces (plus the points with ``keep_input``); ``check`` fails the file when a fit
+    does not meet ε. A later write step whose format cannot hold NURBS writes a mesh whose σ
+    and max |d| are within 2 % of the surface's (at most ``max_triangles``); its accuracy is
+    noted, and ``check`` judges that mesh too."""
+
+    kind: ClassVar[str] = "fit"
+
+    method: str = "hybrid"
+    points: tuple[str, ...] | None = Field(default=None, min_length=1)
+    options: Options = Field(default_factory=dict)
+    keep_input: bool = False
+    check_epsilon: bool = Field(default=False, alias="check")
+    max_triangles: int = Field(default=1_000_000, ge=2)
+    """Bound on the mesh a write step makes of each fitted NURBS surface."""
+
+    model_config = ConfigDict(populate_by_name=True)
+
+    def check(self, registries: Registries) -> None:
+        _get(registries.fitters, self.method, "method").validate_options(self.options)
+
+
+class BuildBlocksStep(StepOptions):
+    """Build blocks, patches, arcs and corners from the scene's conformal surfaces (existing
+    blocks and topology are replaced) with ``builder`` and its ``options``."""
+
+    kind: ClassVar[str] = "build_blocks"
+
+    builder: str = "blocks"
+    options: Options = Field(default_factory=dict)
+
+    def check(self, registries: Registries) -> None:
+        _get(registries.builders, self.builder, "builder").validate_options(self.options)
+
+
+class BuildStep(BuildBlocksStep):
+    """Run any registered builder (a plugin's) on the scene: ``builder`` and its ``options``."""
+
+    kind: ClassVar[str] = "build"
+
+    builder: str
+
+
+class VoxelizeStep(StepOptions):
+    """Append the linear octree of the scene's blocks (or closed surfaces) — the options of
+    :func:`geobrep.voxelize`."""
+
+    kind: ClassVar[str] = "voxelize"
+
+    depth: int = Field(default=8, ge=0)
+    method: Literal["depth-buffer", "exact", "auto"] = "auto"
+    fill_rule: Literal["parity", "nonzero"] = "parity"
+    bodies: tuple[str | int, ...] | None = None
+    origin: tuple[FiniteFloat, FiniteFloat, FiniteFloat] | None = None
+    size: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+    block_depth: int | None = Field(default=None, ge=0)
+    name: str | None = None
+
+    def builder_options(self) -> dict[str, Any]:
+        """The options of the ``voxelize`` builder."""
+        return self.model_dump(exclude_unset=True)
+
+    def check(self, registries: Registries) -> None:
+        _get(registries.builders, "voxelize", "builder").validate_options(self.builder_options())
+
+
+class WriteStep(StepOptions):
+    """Write the scene as it is at this step (the scene flows on unchanged) to
+    ``<output>/<name>``: ``format`` names a registered format, ``name`` a file-name pattern with
+    ``{stem}``, ``{name}``, ``{ext}``, ``{index}`` (default ``{stem}`` + the format's
+    extension); ``options`` are the format's. NURBS surfaces are tessellated when the format
+    cannot hold them (``tessellate``). Files appear only when the whole pipeline succeeded for
+    that input."""
+
+    kind: ClassVar[str] = "write"
+
+    format: str | None = None
+    name: str | None = None
+    options: Options = Field(default_factory=dict)
+    tessellate: bool = True
+
+    @model_validator(mode="after")
+    def _target(self) -> WriteStep:
+        if self.format is None and self.name is None:
+            raise ValueError("give a format, a file name pattern (name), or both")
+        if self.name is not None:
+            _check_pattern(self.name)
+        return self
+
+    def pattern(self, registries: Registries) -> str:
+        """The file-name pattern, with the format's extension when ``name`` is not given."""
+        if self.name is not None:
+            return self.name
+        spec = registries.formats.get(str(self.format))
+        return "{stem}" + (spec.extensions[0] if spec.extensions else f".{spec.name}")
+
+    def format_name(self, registries: Registries) -> str:
+        """The registered format this step writes with."""
+        if self.format is not None:
+            return self.format
+        sample = self.pattern(registries).format(stem="x", name="x.x", ext=".x", index=0)
+        return registries.formats.choose_writer(Path(sample)).name
+
+    def check(self, registries: Registries) -> None:
+        if self.format is not None:
+            spec = _get(registries.formats, self.format)
+            if not spec.can_write:
+                raise OptionsError(
+                    f"format {self.format!r} cannot write; formats that can: "
+                    + ", ".join(s.name for s in registries.formats.writers())
+                )
+        else:
+            spec = registries.formats.get(self.format_name(registries))
+        spec.validate_options(self.options)
+
+
+class ConvertStep(WriteStep):
+    """The same as ``write``: ``convert: {format: vtu}`` reads naturally after ``read``."""
+
+    kind: ClassVar[str] = "convert"
+
+
+_STEP_TYPES: tuple[type[StepOptions], ...] = (
+    ReadStep,
+    ReprojectStep,
+    ClipStep,
+    ClipBoxStep,
+    SectionStep,
+    FitStep,
+    BuildBlocksStep,
+    BuildStep,
+    VoxelizeStep,
+    WriteStep,
+    ConvertStep,
+)
+STEP_KINDS: tuple[str, ...] = tuple(t.kind for t in _STEP_TYPES)
+"""Every step kind, in the order the documentation presents them."""
+_BY_KIND = {t.kind: t for t in _STEP_TYPES}
+
+
+# One wrapper per kind: a step is written as a mapping with one key, the kind.
+class _Entry(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    @property
+    def body(self) -> StepOptions:
+        value = next(iter(self.__dict__.values()))
+        assert isinstance(value, StepOptions)
+        return value
+
+
+class ReadEntry(_Entry):
+    read: ReadStep
+
+
+class ReprojectEntry(_Entry):
+    reproject: ReprojectStep
+
+
+class ClipEntry(_Entry):
+    clip: ClipStep
+
+
+class ClipBoxEntry(_Entry):
+    clip_box: ClipBoxStep
+
+
+class SectionEntry(_Entry):
+    section: SectionStep
+
+
+class FitEntry(_Entry):
+    fit: FitStep
+
+
+class BuildBlocksEntry(_Entry):
+    build_blocks: BuildBlocksStep
+
+
+class BuildEntry(_Entry):
+    build: BuildStep
+
+
+class VoxelizeEntry(_Entry):
+    voxelize: VoxelizeStep
+
+
+class WriteEntry(_Entry):
+    write: WriteStep
+
+
+class ConvertEntry(_Entry):
+    convert: ConvertStep
+
+
+def _step_tag(value: Any) -> str | None:
+    if isinstance(value, Mapping) and len(value) == 1:
+        return str(next(iter(value)))
+    if isinstance(value, _Entry):
+        return value.body.kind
+    return None
+
+
+Step = Annotated[
+    Union[  # noqa: UP007  (the members carry tags)
+        Annotated[ReadEntry, Tag("read")],
+        Annotated[ReprojectEntry, Tag("reproject")],
+        Annotated[ClipEntry, Tag("clip")],
+        Annotated[ClipBoxEntry, Tag("clip_box")],
+        Annotated[SectionEntry, Tag("section")],
+        Annotated[FitEntry, Tag("fit")],
+        Annotated[BuildBlocksEntry, Tag("build_blocks")],
+        Annotated[BuildEntry, Tag("build")],
+        Annotated[VoxelizeEntry, Tag("voxelize")],
+        Annotated[WriteEntry, Tag("write")],
+        Annotated[ConvertEntry, Tag("convert")],
+    ],
+    Discriminator(_step_tag),
+]
+
+
+class Pipeline(BaseModel):
+    """A pipeline document: ``version``, ``inputs``, ``output`` and ``steps``.
+
+    Build one from a file with :meth:`load`, from a mapping with :meth:`from_data`; steps may
+    also be given as step bodies (``ClipStep(plane=(1, 0, 0, -5))``). Relative ``inputs`` and
+    ``output`` are relative to the pipeline file (:attr:`base_dir`), else to the working folder.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+        frozen=True,
+        use_attribute_docstrings=True,
+        title="geobrep pipeline",
+        json_schema_extra={
+            "description": "A geobrep pipeline: steps applied to every input file "
+            "(geobrep run pipeline.yaml)."
+        },
+    )
+
+    version: Literal[1] = 1
+    inputs: tuple[str, ...] = ()
+    """Input files: paths or glob patterns (``models/**/*.ts``)."""
+    output: str = "output"
+    """The folder outputs are written to (created when missing)."""
+    steps: tuple[Step, ...] = Field(min_length=1)
+    """The steps, applied in order to each input; the scene flows from one to the next."""
+
+    _base_dir: Path | None = PrivateAttr(default=None)
+    _source: str = PrivateAttr(default="pipeline")
+
+    @field_validator("inputs", mode="before")
+    @classmethod
+    def _one_input(cls, value: Any) -> Any:
+        return [value] if isinstance(value, str | PathLike) else value
+
+    @field_validator("steps", mode="before")
+    @classmethod
+    def _step_shapes(cls, value: Any) -> Any:
+        if not isinstance(value, list | tuple):
+            return value
+        return [_shape(number, item) for number, item in enumerate(value, 1)]
+
+    @model_validator(mode="after")
+    def _order(self) -> Pipeline:
+        kinds = [step.kind for step in self.step_list]
+        if "read" in kinds[1:]:
+            raise ValueError(
+                f"step {kinds.index('read', 1) + 1}: read must be the first step (or left out)"
+            )
+        if not {"write", "convert"} & set(kinds):
+            raise ValueError("the pipeline writes nothing: add a write step")
+        return self
+
+    # -- access ---------------------------------------------------------------------------------
+    @property
+    def step_list(self) -> list[StepOptions]:
+        """The step bodies, in order."""
+        return [entry.body for entry in self.steps]
+
+    @property
+    def base_dir(self) -> Path | None:
+        """The folder of the pipeline file (None for a pipeline built in Python)."""
+        return self._base_dir
+
+    def with_base_dir(self, folder: PathArg | None) -> Pipeline:
+        """This pipeline with relative paths resolved against ``folder``."""
+        copy = self.model_copy()
+        copy._base_dir = None if folder is None else Path(folder)
+        copy._source = self._source
+        return copy
+
+    # -- construction ---------------------------------------------------------------------------
+    @classmethod
+    def from_data(cls, data: Any, source: str = "pipeline") -> Pipeline:
+        """Validate a parsed document; errors are one :class:`OptionsError` naming each step."""
+        if isinstance(data, Pipeline):
+            return data
+        if not isinstance(data, Mapping):
+            raise OptionsError(
+                f"{source}: a pipeline is a mapping (version, inputs, output, steps), "
+                f"not {type(data).__name__}"
+            )
+        try:
+            pipeline = cls.model_validate(data)
+        except ValidationError as exc:
+            raise OptionsError(f"{source}: {_describe(exc, data)}") from exc
+        pipeline._source = source
+        return pipeline
+
+    @classmethod
+    def load(cls, path: PathArg) -> Pipeline:
+        """Read a pipeline file (``.yaml``/``.yml``, or ``.json``) and validate it.
+
+        Raises:
+            FileAccessError: the file is missing or unreadable.
+            FormatError: not valid YAML/JSON (with the line).
+            OptionsError: the document is not a valid pipeline.
+        """
+        file = Path(path)
+        try:
+            text = file.read_text(encoding="utf-8")
+        except FileNotFoundError as exc:
+            raise FileAccessError("no such file", file) from exc
+        except (OSError, UnicodeDecodeError) as exc:
+            raise FileAccessError(f"cannot be read ({exc})", file) from exc
+        data = _parse(text, file)
+        return cls.from_data(data, source=str(file)).with_base_dir(file.parent)
+
+    # -- plugin resolution ----------------------------------------------------------------------
+    def check(self, registries: Registries | None = None) -> Pipeline:
+        """Resolve every format, clipper, fitter and builder and validate its options.
+
+        Returns ``self``; raises :class:`OptionsError` naming the step, its kind and the option.
+        """
+        if registries is None:
+            from geobrep.plugins import registries as loaded
+
+            registries = loaded()
+        for number, step in enumerate(self.step_list, 1):
+            try:
+                step.check(registries)
+            except GeobrepError as exc:
+                raise OptionsError(f"{self._source}: step {number} ({step.kind}): {exc}") from exc
+        writes = [
+            (number, step.pattern(registries))
+            for number, step in enumerate(self.step_list, 1)
+            if isinstance(step, WriteStep)
+        ]
+        seen: dict[str, int] = {}
+        for number, pattern in writes:
+            if pattern in seen:
+                raise OptionsError(
+                    f"{self._source}: steps {seen[pattern]} and {number} both write "
+                    f"{pattern!r}: give one a different name pattern"
+                )
+            seen[pattern] = number
+        return self
+
+
+def _shape(number: int, item: Any) -> Any:
+    """Check that a step is ``{kind: body}``; bare ``kind`` strings and bodies are accepted."""
+    if isinstance(item, StepOptions):
+        return {item.kind: item}
+    if isinstance(item, _Entry):
+        return item
+    if isinstance(item, str):
+        item = {item: None}
+    if not isinstance(item, Mapping) or not item:
+        raise ValueError(
+            f"step {number}: a step is a mapping with one key, its kind (e.g. clip: {{...}}), "
+            f"not {item!r}"
+        )
+    if len(item) != 1:
+        keys = ", ".join(repr(str(k)) for k in item)
+        kinds = [str(k) for k in item if k in _BY_KIND]
+        hint = (
+            f" (indent the options of {kinds[0]!r} under it)"
+            if len(kinds) == 1 and item[kinds[0]] is None
+            else ""
+        )
+        raise ValueError(
+            f"step {number}: a step is a mapping with one key, its kind; got {keys}{hint}"
+        )
+    kind, body = next(iter(item.items()))
+    if kind not in _BY_KIND:
+        raise ValueError(
+            f"step {number}: unknown step kind {kind!r}; step kinds: {', '.join(STEP_KINDS)}"
+        )
+    return {kind: {} if body is None else body}
+
+
+def _describe(exc: ValidationError, data: Mapping[str, Any]) -> str:
+    steps = data.get("steps")
+    problems: list[str] = []
+    errors = exc.errors(include_url=False)
+    if any(e["loc"][:1] == ("steps",) and len(e["loc"]) > 1 for e in errors):
+        # pydantic also counts the failed steps as missing: that is no news
+        errors = [e for e in errors if not (e["loc"] == ("steps",) and e["type"] == "too_short")]
+    for error in errors:
+        loc = list(error["loc"])
+        message = str(error["msg"]).removeprefix("Value error, ")
+        if error["type"] == "extra_forbidden":
+            message = "unknown option"
+        if loc[:1] == ["steps"] and len(loc) >= 2 and isinstance(loc[1], int):
+            number = loc[1] + 1
+            kind = _step_tag(steps[loc[1]]) if isinstance(steps, list | tuple) else None
+            rest = loc[2:]
+            while rest and rest[0] == kind:  # the union tag, then the wrapper's field
+                rest = rest[1:]
+            where = f"step {number} ({kind})" if kind else f"step {number}"
+            if error["type"] == "extra_forbidden" and rest and kind in _BY_KIND:
+                valid = ", ".join(option_names(_BY_KIND[kind]))
+                message = f"unknown option (valid options: {valid})"
+            option = ".".join(str(part) for part in rest)
+            problems.append(
+                f"{where}: option {option!r}: {message}" if option else f"{where}: {message}"
+            )
+        elif loc == ["steps"] and message.startswith("step "):
+            problems.append(message)
+        elif loc:
+            field = ".".join(str(part) for part in loc)
+            if error["type"] == "extra_forbidden":
+                message = f"unknown field (fields: {', '.join(Pipeline.model_fields)})"
+            problems.append(f"{field}: {message}")
+        else:
+            problems.append(message)
+    return "; ".join(problems)
+
+
+def option_names(step_type: type[StepOptions]) -> list[str]:
+    """The keys a step body takes (aliases where a field has one), in declaration order.
+
+    >>> option_names(FitStep)
+    ['method', 'points', 'options', 'keep_input', 'check', 'max_triangles']
+    """
+    return [info.alias or name for name, info in step_type.model_fields.items()]
+
+
+def _parse(text: str, file: Path) -> Any:
+    if file.suffix.lower() == ".json":
+        try:
+            return json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise FormatError(f"not valid JSON: {exc.msg}", file, exc.lineno) from exc
+    import yaml
+
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        problem = getattr(exc, "problem", None) or str(exc)
+        line = mark.line + 1 if mark is not None else None
+        raise FormatError(f"not valid YAML: {problem}", file, line) from exc
+
+
+def _check_pattern(pattern: str) -> None:
+    try:
+        fields = [f for _, f, _, _ in string.Formatter().parse(pattern) if f is not None]
+    except ValueError as exc:
+        raise ValueError(f"name pattern {pattern!r}: {exc}") from exc
+    for field in fields:
+        if field.split(".")[0].split("[")[0] not in NAME_FIELDS:
+            raise ValueError(
+                f"name pattern {pattern!r}: unknown field {{{field}}}; "
+                f"fields: {', '.join('{' + f + '}' for f in NAME_FIELDS)}"
+            )
+    if "/" in pattern or "\\" in pattern:
+        raise ValueError(f"name pattern {pattern!r}: a file name, not a path")
+
+
+def _get(registry: Any, name: str, option: str = "format") -> Any:
+    from geobrep.host.registry import UnknownItemError
+
+    try:
+        return registry.get(name)
+    except UnknownItemError as exc:
+        raise OptionsError(f"option {option!r}: {exc}") from exc

@@ -1,0 +1,637 @@
+"""The items plugins register, and the registries that hold them.
+
+A plugin hook receives a registry and adds items to it::
+
+    registry.add(FormatSpec(name="xyz", extensions=(".xyz",), reader=read_xyz))
+
+Every item is a frozen pydantic model with a ``name`` (lowercase, e.g. ``"xyz"``,
+``"surface.plane"``), a ``description``, an ``options`` model validated by
+:meth:`RegisteredItem.validate_options`, and the ``plugin`` that registered it (filled by
+the loader). Names are unique per registry: a second plugin registering a taken name gets a
+:class:`GeobrepPluginWarning` and the first registration wins; one plugin registering a
+name twice is a :class:`~geobrep.errors.PluginError`.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar, Generic, TypeVar
+
+from pydantic import (
+    AliasChoices,
+    BaseModel,
+    ConfigDict,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+
+from geobrep.errors import GeobrepError, OptionsError, PluginError, UnknownFormatError
+
+__all__ = [
+    "SNIFF_BYTES",
+    "BuilderRegistry",
+    "BuilderSpec",
+    "ClipperRegistry",
+    "ClipperSpec",
+    "FitterRegistry",
+    "FitterSpec",
+    "FormatCapabilities",
+    "FormatRegistry",
+    "FormatSpec",
+    "GeobrepPluginWarning",
+    "NoOptions",
+    "RegisteredItem",
+    "Registries",
+    "Registry",
+    "UnknownItemError",
+]
+
+SNIFF_BYTES = 4096
+"""How many leading bytes of a file a format's ``sniff`` function receives."""
+
+_NAME_PATTERN = re.compile(r"[a-z0-9][a-z0-9_.-]*")
+_EXTENSION_PATTERN = re.compile(r"(\.[a-z0-9_+~-]+)+")
+
+
+class GeobrepPluginWarning(UserWarning):
+    """A plugin failed to load, or its item lost a name clash; geobrep carries on without it."""
+
+
+class UnknownItemError(GeobrepError, KeyError):
+    """No item of that name is registered; the message lists the registered names."""
+
+    def __str__(self) -> str:
+        # KeyError would show the repr of the message, quotes and all.
+        return str(self.args[0]) if self.args else ""
+
+
+class NoOptions(BaseModel):
+    """The options model of an item that takes no options: any option is rejected."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def _format_loc(loc: tuple[int | str, ...]) -> str:
+    return ".".join(str(part) for part in loc)
+
+
+class RegisteredItem(BaseModel):
+    """What every registered item has: a name, a description, an options model, a plugin.
+
+    Example:
+        >>> class PlaneOptions(BaseModel):
+        ...     model_config = ConfigDict(extra="forbid")
+        ...     tolerance: float = 1e-9
+        >>> item = RegisteredItem(name="plane", options=PlaneOptions)
+        >>> item.validate_options(tolerance=0.5)
+        PlaneOptions(tolerance=0.5)
+    """
+
+    model_config = ConfigDict(frozen=True, arbitrary_types_allowed=True)
+
+    kind: ClassVar[str] = "item"
+
+    name: str
+    description: str = ""
+    options: type[BaseModel] = NoOptions
+    plugin: str = ""
+
+    @field_validator("name")
+    @classmethod
+    def _check_name(cls, value: str) -> str:
+        if not _NAME_PATTERN.fullmatch(value):
+            raise ValueError(
+                f"{cls.kind} name {value!r} is not valid: use lowercase letters, digits "
+                "and '_', '.', '-', starting with a letter or digit (e.g. 'xyz', 'surface.plane')"
+            )
+        return value
+
+    @property
+    def label(self) -> str:
+        """``"format 'xyz'"``: how messages name this item."""
+        return f"{self.kind} {self.name!r}"
+
+    def validate_options(
+        self, options: Mapping[str, Any] | BaseModel | None = None, /, **kwargs: Any
+    ) -> BaseModel:
+        """Validate ``options`` (a mapping or model instance) plus keywords into ``self.options``.
+
+        Unknown options are rejected even when the options model forgot ``extra="forbid"``.
+
+        Raises:
+            OptionsError: naming this item and each bad option.
+
+        Example:
+            >>> RegisteredItem(name="noop").validate_options({"speed": 3})
+            Traceback (most recent call last):
+            ...
+            geobrep.errors.OptionsError: item 'noop': option 'speed': unknown option (this item takes no options)
+        """  # noqa: E501
+        model = self.options
+        if isinstance(options, model) and not kwargs:
+            return options
+        if isinstance(options, BaseModel):
+            if not isinstance(options, model):
+                raise OptionsError(
+                    f"{self.label}: options must be a {model.__name__} "
+                    f"(or a mapping), not a {type(options).__name__}"
+                )
+            data: dict[str, Any] = options.model_dump(exclude_unset=True)
+        elif options is None:
+            data = {}
+        elif isinstance(options, Mapping):
+            data = dict(options)
+        else:
+            raise OptionsError(
+                f"{self.label}: options must be a mapping or a {model.__name__}, "
+                f"not a {type(options).__name__}"
+            )
+        for key in kwargs:
+            if key in data and not isinstance(options, BaseModel):
+                raise OptionsError(f"{self.label}: option {key!r} given twice")
+        data.update(kwargs)
+        self._reject_unknown(data)
+        try:
+            return model.model_validate(data)
+        except ValidationError as exc:
+            raise OptionsError(f"{self.label}: {self._describe(exc)}") from exc
+
+    def _accepted_keys(self) -> set[str]:
+        keys: set[str] = set()
+        for field_name, info in self.options.model_fields.items():
+            keys.add(field_name)
+            if info.alias:
+                keys.add(info.alias)
+            if isinstance(info.validation_alias, str):
+                keys.add(info.validation_alias)
+            elif isinstance(info.validation_alias, AliasChoices):
+                keys.update(c for c in info.validation_alias.choices if isinstance(c, str))
+        return keys
+
+    def _valid_options_text(self) -> str:
+        names = sorted(self.options.model_fields)
+        if not names:
+            return "this item takes no options"
+        return "valid options: " + ", ".join(names)
+
+    def _reject_unknown(self, data: Mapping[Any, Any]) -> None:
+        extra = self.options.model_config.get("extra")
+        if extra in ("forbid", "allow"):
+            return  # pydantic rejects (or deliberately keeps) extras itself
+        accepted = self._accepted_keys()
+        unknown = [key for key in data if key not in accepted]
+        if unknown:
+            problems = "; ".join(
+                f"option {key!r}: unknown option ({self._valid_options_text()})" for key in unknown
+            )
+            raise OptionsError(f"{self.label}: {problems}")
+
+    def _describe(self, exc: ValidationError) -> str:
+        problems = []
+        for error in exc.errors(include_url=False):
+            loc = _format_loc(error["loc"])
+            message = error["msg"]
+            if error["type"] == "extra_forbidden":
+                message = f"unknown option ({self._valid_options_text()})"
+            problems.append(f"option {loc!r}: {message}" if loc else f"options: {message}")
+        return "; ".join(problems)
+
+
+class FormatCapabilities(BaseModel):
+    """What a format can store, so callers can warn before a lossy write.
+
+    Example:
+        >>> FormatCapabilities(entity_types=frozenset({"PointSet"}), point_data=True).point_data
+        True
+    """
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    entity_types: frozenset[str] = frozenset()
+    point_data: bool = False
+    cell_data: bool = False
+    names: bool = False
+    ids: bool = False
+    topology: bool = False
+    crs: bool = False
+    multiple_entities: bool = False
+    empty_entities: bool = False
+    """Entities without geometry (a GOCAD header-only object) are kept, not dropped."""
+
+
+class FormatSpec(RegisteredItem):
+    """A file format: extensions, a reader and/or a writer, an optional content sniffer.
+
+    ``reader(path, options) -> Scene``, ``writer(scene, path, options) -> None`` and
+    ``sniff(first_bytes) -> bool`` (the first :data:`SNIFF_BYTES` bytes of the file).
+
+    Example:
+        >>> spec = FormatSpec(name="xyz", extensions=("XYZ",), reader=lambda path, options: None)
+        >>> spec.extensions, spec.can_read, spec.can_write
+        (('.xyz',), True, False)
+    """
+
+    kind: ClassVar[str] = "format"
+
+    extensions: tuple[str, ...] = ()
+    reader: Callable[..., Any] | None = None
+    writer: Callable[..., Any] | None = None
+    sniff: Callable[[bytes], bool] | None = None
+    capabilities: FormatCapabilities = FormatCapabilities()
+    losses: Callable[..., list[str]] | None = None
+    """``losses(scene, path) -> [sentence, ...]``: what the writer drops for this target beyond
+    what :attr:`capabilities` says (e.g. a GOCAD .ts holds surfaces only)."""
+    generic_content: bool = False
+    """The sniffer recognises generic content (e.g. rows of plain numbers): the format is
+    chosen by content only when no other format's sniffer recognises the file."""
+
+    @field_validator("extensions", mode="before")
+    @classmethod
+    def _normalise_extensions(cls, value: Any) -> Any:
+        if isinstance(value, str):
+            value = (value,)
+        if not isinstance(value, Iterable):
+            return value  # let pydantic report the type error
+        normalised: list[str] = []
+        for raw in value:
+            if not isinstance(raw, str):
+                raise ValueError(f"extension {raw!r} is not a string")
+            ext = raw.strip().lower()
+            if not ext.startswith("."):
+                ext = "." + ext
+            if not _EXTENSION_PATTERN.fullmatch(ext):
+                raise ValueError(f"extension {raw!r} is not valid (expected e.g. '.ts', '.tar.gz')")
+            if ext not in normalised:
+                normalised.append(ext)
+        return tuple(normalised)
+
+    @model_validator(mode="after")
+    def _needs_reader_or_writer(self) -> FormatSpec:
+        if self.reader is None and self.writer is None:
+            raise ValueError(f"format {self.name!r} needs a reader, a writer or both")
+        return self
+
+    @property
+    def can_read(self) -> bool:
+        """True if this format has a reader."""
+        return self.reader is not None
+
+    @property
+    def can_write(self) -> bool:
+        """True if this format has a writer."""
+        return self.writer is not None
+
+    def matches(self, path: Path | str) -> str | None:
+        """The longest of this format's extensions that ends ``path``'s file name, if any."""
+        file_name = Path(path).name.lower()
+        hits = [ext for ext in self.extensions if file_name.endswith(ext) and file_name != ext]
+        return max(hits, key=len) if hits else None
+
+
+class ClipperSpec(RegisteredItem):
+    """Cuts one entity type by a plane.
+
+    ``function(entity, plane, keep, options, context)`` returns the clipped entity (same type) or
+    ``None`` for ``keep="negative"`` / ``"positive"``, and the tuple ``(negative, positive)`` for
+    ``keep="both"``; ``context`` is a :class:`geobrep.ops.clipping.ClipContext`. The optional
+    ``section(entity, plane, options, context)`` returns the cut itself (a lower-dimensional
+    entity on the plane) or ``None``.
+
+    Example:
+        >>> spec = ClipperSpec(name="pointset", entity_type="PointSet",
+        ...                    function=lambda entity, plane, keep, options, context: entity)
+        >>> spec.kind, spec.section is None
+        ('clipper', True)
+    """
+
+    kind: ClassVar[str] = "clipper"
+
+    entity_type: str
+    function: Callable[..., Any]
+    section: Callable[..., Any] | None = None
+
+
+class FitterSpec(RegisteredItem):
+    """Fits a surface or curve to data: ``function(entities, options) -> entity``.
+
+    Example:
+        >>> FitterSpec(name="plane", function=lambda e, o: None, input_types=("PointSet",)).kind
+        'fitter'
+    """
+
+    kind: ClassVar[str] = "fitter"
+
+    function: Callable[..., Any]
+    input_types: tuple[str, ...] = ()
+
+
+class BuilderSpec(RegisteredItem):
+    """Builds derived structure (topology, blocks): ``function(scene, options) -> Scene``.
+
+    Example:
+        >>> BuilderSpec(name="blocks", function=lambda s, o: s, input_types=("Surface",)).kind
+        'builder'
+    """
+
+    kind: ClassVar[str] = "builder"
+
+    function: Callable[..., Any]
+    input_types: tuple[str, ...] = ()
+
+
+T = TypeVar("T", bound=RegisteredItem)
+
+
+class Registry(Generic[T]):
+    """Items of one kind by name, iterated in name order.
+
+    ``plugin``, when given, stamps every added item as registered by that plugin (the
+    loader gives each plugin its own staging registry this way).
+
+    Example:
+        >>> registry = ClipperRegistry()
+        >>> _ = registry.add(ClipperSpec(name="pointset", entity_type="PointSet", function=print))
+        >>> registry.names(), "pointset" in registry
+        (['pointset'], True)
+    """
+
+    item_type: ClassVar[type[RegisteredItem]] = RegisteredItem
+
+    def __init__(self, items: Iterable[T] = (), *, plugin: str | None = None) -> None:
+        self._items: dict[str, T] = {}
+        self.plugin = plugin
+        for item in items:
+            self.add(item)
+
+    @property
+    def kind(self) -> str:
+        """The kind of item held, e.g. ``"format"``."""
+        return self.item_type.kind
+
+    def add(self, item: T) -> T:
+        """Register ``item``; return the item now registered under its name.
+
+        A name taken by another plugin warns and keeps the first item; a name registered
+        twice by the same plugin raises :class:`~geobrep.errors.PluginError`.
+        """
+        if not isinstance(item, self.item_type):
+            raise PluginError(
+                f"{type(self).__name__}.add() takes a {self.item_type.__name__}, "
+                f"not {type(item).__name__} ({item!r:.80})"
+            )
+        if self.plugin is not None and item.plugin != self.plugin:
+            item = item.model_copy(update={"plugin": self.plugin})
+        existing = self._items.get(item.name)
+        if existing is None:
+            self._items[item.name] = item
+            return item
+        if existing.plugin == item.plugin:
+            raise PluginError(
+                f"{item.label} registered twice by {_plugin_label(item.plugin)}: "
+                "each name may be registered once"
+            )
+        warnings.warn(
+            f"{item.label} from {_plugin_label(item.plugin)} ignored: the name is already "
+            f"registered by {_plugin_label(existing.plugin)}",
+            GeobrepPluginWarning,
+            stacklevel=2,
+        )
+        return existing
+
+    def get(self, name: str) -> T:
+        """The item called ``name``; :class:`UnknownItemError` lists the names if absent."""
+        try:
+            return self._items[name]
+        except KeyError:
+            raise UnknownItemError(f"unknown {self.kind} {name!r}; {self._available()}") from None
+
+    def names(self) -> list[str]:
+        """Registered names, sorted."""
+        return sorted(self._items)
+
+    def _available(self) -> str:
+        if not self._items:
+            return f"no {self.kind}s are registered"
+        return f"registered {self.kind}s: " + ", ".join(self.names())
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._items
+
+    def __iter__(self) -> Iterator[T]:
+        return iter([self._items[name] for name in self.names()])
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.names()!r})"
+
+
+def _plugin_label(plugin: str) -> str:
+    return f"plugin {plugin!r}" if plugin else "direct registration"
+
+
+def _read_head(path: Path) -> bytes:
+    """The first :data:`SNIFF_BYTES` of ``path``, or ``b""`` if it cannot be read."""
+    try:
+        with path.open("rb") as stream:
+            return stream.read(SNIFF_BYTES)
+    except (OSError, ValueError):
+        return b""
+
+
+def _describe_formats(formats: Iterable[FormatSpec]) -> str:
+    parts = []
+    for spec in formats:
+        extensions = ", ".join(spec.extensions) or "no extension"
+        origin = f", plugin {spec.plugin!r}" if spec.plugin else ""
+        parts.append(f"{spec.name} ({extensions}{origin})")
+    return "; ".join(parts) if parts else "none"
+
+
+class FormatRegistry(Registry[FormatSpec]):
+    """File formats, with reader/writer choice by name, extension and content.
+
+    Example:
+        >>> formats = FormatRegistry()
+        >>> _ = formats.add(FormatSpec(name="xyz", extensions=(".xyz",), reader=print))
+        >>> formats.choose_reader(Path("points.XYZ")).name
+        'xyz'
+    """
+
+    item_type: ClassVar[type[RegisteredItem]] = FormatSpec
+
+    def for_extension(self, ext: str) -> list[FormatSpec]:
+        """Formats declaring extension ``ext`` (``"xyz"`` or ``".XYZ"`` alike), by name."""
+        wanted = ext.strip().lower()
+        if not wanted.startswith("."):
+            wanted = "." + wanted
+        return [spec for spec in self if wanted in spec.extensions]
+
+    def readers(self) -> list[FormatSpec]:
+        """Formats that can read, by name."""
+        return [spec for spec in self if spec.can_read]
+
+    def writers(self) -> list[FormatSpec]:
+        """Formats that can write, by name."""
+        return [spec for spec in self if spec.can_write]
+
+    def choose_reader(self, path: Path | str, format: str | None = None) -> FormatSpec:
+        """The format to read ``path`` with.
+
+        An explicit ``format`` name wins; otherwise the longest matching extension, with
+        sniffing of the first :data:`SNIFF_BYTES` bytes to decide between several formats
+        or when no extension matches (formats with ``generic_content`` only when no other
+        sniffer recognises the file).
+
+        Raises:
+            UnknownFormatError: nothing matches, or several formats match equally.
+        """
+        path = Path(path)
+        if format is not None:
+            return self._named(format, path, "read")
+        readers = self.readers()
+        candidates = _longest_match(readers, path)
+        if len(candidates) == 1:
+            return candidates[0]
+        head = _read_head(path)
+        pool = candidates or readers
+        sniffed = [spec for spec in pool if self._sniffs(spec, head)]
+        specific = [spec for spec in sniffed if not spec.generic_content]
+        if specific and len(specific) < len(sniffed):
+            sniffed = specific  # a format that knows this content beats a generic one
+        if len(sniffed) == 1:
+            return sniffed[0]
+        if sniffed or candidates:
+            self._ambiguous(sniffed or candidates, path, "read")
+        raise UnknownFormatError(
+            f"no installed format can read this file (extension "
+            f"{''.join(path.suffixes).lower() or 'none'}, content not recognised); "
+            f"formats that can read: {_describe_formats(readers)}",
+            path=path,
+        )
+
+    def choose_writer(self, path: Path | str, format: str | None = None) -> FormatSpec:
+        """The format to write ``path`` with: explicit ``format`` name, else extension.
+
+        Raises:
+            UnknownFormatError: nothing matches, or several formats share the extension.
+        """
+        path = Path(path)
+        if format is not None:
+            return self._named(format, path, "write")
+        writers = self.writers()
+        candidates = _longest_match(writers, path)
+        if len(candidates) == 1:
+            return candidates[0]
+        if candidates:
+            self._ambiguous(candidates, path, "write")
+        raise UnknownFormatError(
+            f"no installed format writes extension "
+            f"{''.join(path.suffixes).lower() or '(none)'}; "
+            f"formats that can write: {_describe_formats(writers)}; pass format='<name>'",
+            path=path,
+        )
+
+    def _named(self, name: str, path: Path, action: str) -> FormatSpec:
+        able = self.readers() if action == "read" else self.writers()
+        if name not in self:
+            raise UnknownFormatError(
+                f"unknown format {name!r}; formats that can {action}: {_describe_formats(able)}",
+                path=path,
+            )
+        spec = self.get(name)
+        if (action == "read" and not spec.can_read) or (action == "write" and not spec.can_write):
+            raise UnknownFormatError(
+                f"format {name!r} cannot {action}; formats that can {action}: "
+                f"{_describe_formats(able)}",
+                path=path,
+            )
+        return spec
+
+    @staticmethod
+    def _ambiguous(candidates: list[FormatSpec], path: Path, action: str) -> None:
+        raise UnknownFormatError(
+            f"several formats can {action} this file: {_describe_formats(candidates)}; "
+            f"pass format='<name>' to choose one",
+            path=path,
+        )
+
+    @staticmethod
+    def _sniffs(spec: FormatSpec, head: bytes) -> bool:
+        if spec.sniff is None or not head:
+            return False
+        try:
+            return bool(spec.sniff(head))
+        except Exception as exc:
+            warnings.warn(
+                f"{spec.label} from {_plugin_label(spec.plugin)}: sniff raised "
+                f"{type(exc).__name__}: {exc}; treated as no match",
+                GeobrepPluginWarning,
+                stacklevel=3,
+            )
+            return False
+
+
+def _longest_match(formats: list[FormatSpec], path: Path) -> list[FormatSpec]:
+    matched = [(spec, spec.matches(path)) for spec in formats]
+    longest = max((len(ext) for _, ext in matched if ext), default=0)
+    return [spec for spec, ext in matched if ext and len(ext) == longest]
+
+
+class ClipperRegistry(Registry[ClipperSpec]):
+    """Clippers, one per entity type or variant."""
+
+    item_type: ClassVar[type[RegisteredItem]] = ClipperSpec
+
+    def for_entity_type(self, entity_type: str) -> list[ClipperSpec]:
+        """Clippers declared for ``entity_type`` (e.g. ``"Surface"``), by name."""
+        return [spec for spec in self if spec.entity_type == entity_type]
+
+
+class FitterRegistry(Registry[FitterSpec]):
+    """Surface and curve fitters."""
+
+    item_type: ClassVar[type[RegisteredItem]] = FitterSpec
+
+
+class BuilderRegistry(Registry[BuilderSpec]):
+    """Topology and block builders."""
+
+    item_type: ClassVar[type[RegisteredItem]] = BuilderSpec
+
+
+@dataclass(frozen=True)
+class Registries:
+    """The four registries, one per hook kind.
+
+    Example:
+        >>> Registries().formats
+        FormatRegistry([])
+    """
+
+    formats: FormatRegistry = field(default_factory=FormatRegistry)
+    clippers: ClipperRegistry = field(default_factory=ClipperRegistry)
+    fitters: FitterRegistry = field(default_factory=FitterRegistry)
+    builders: BuilderRegistry = field(default_factory=BuilderRegistry)
+
+    KINDS: ClassVar[tuple[str, ...]] = ("formats", "clippers", "fitters", "builders")
+
+    @classmethod
+    def staging(cls, plugin: str) -> Registries:
+        """Empty registries that stamp each added item with ``plugin``."""
+        return cls(
+            formats=FormatRegistry(plugin=plugin),
+            clippers=ClipperRegistry(plugin=plugin),
+            fitters=FitterRegistry(plugin=plugin),
+            builders=BuilderRegistry(plugin=plugin),
+        )
+
+    def by_kind(self) -> dict[str, Registry[Any]]:
+        """``{"formats": ..., "clippers": ..., ...}``."""
+        return {kind: getattr(self, kind) for kind in self.KINDS}
