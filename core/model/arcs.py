@@ -217,6 +217,180 @@ def _empty_chains() -> ArcChains:
     return ArcChains(empty, empty, empty, one, empty, one, empty, empty, empty)
 
 
+def _edge_components(a: IntArray, b: IntArray, n: int) -> IntArray:
+    """Chain label of each of ``n`` arc edges, ``a[i]`` and ``b[i]`` continuing each other."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    graph = coo_matrix((np.ones(a.shape[0], np.int8), (a, b)), shape=(n, n))
+    labels: IntArray = connected_components(graph, directed=False)[1].astype(np.int64)
+    return labels
+
+
+def _corner_closed_chains(
+    ends: IntArray, component: IntArray, rank: IntArray, corner: BoolArray
+) -> bool:
+    """Rule 5: give every closed chain without a corner its lowest vertex as one.
+
+    ``corner`` is updated in place; returns whether any chain was closed.
+    """
+    n_components = int(component.max()) + 1
+    touches = (corner[ends[:, 0]] | corner[ends[:, 1]]).astype(np.float64)
+    closed = np.flatnonzero(np.bincount(component, weights=touches, minlength=n_components) == 0)
+    if not closed.size:
+        return False
+    lowest = np.full(n_components, np.iinfo(np.int64).max, dtype=np.int64)
+    np.minimum.at(lowest, component, np.minimum(rank[ends[:, 0]], rank[ends[:, 1]]))
+    by_rank = np.empty(int(rank.max()) + 1, dtype=np.int64)
+    by_rank[rank[rank >= 0]] = np.flatnonzero(rank >= 0)
+    corner[by_rank[lowest[closed]]] = True
+    return True
+
+
+@dataclass(frozen=True)
+class _Links:
+    """Corners (per vertex), vertex ranks and how the arc edges continue each other."""
+
+    corner: BoolArray
+    rank: IntArray
+    a: IntArray
+    b: IntArray
+    component: IntArray
+
+
+def _find_corners(
+    edges: IntArray,
+    offsets: IntArray,
+    incident_patch: IntArray,
+    ends: IntArray,
+    signature: IntArray,
+    n_vertices: int,
+    points: NDArray[np.float64] | None,
+    extra_corners: BoolArray | None,
+) -> _Links:
+    """Corners by rules 1 to 5 and the chains of arc edges between them."""
+    corner = np.zeros(n_vertices, dtype=np.bool_)
+    _touch_corners(edges, offsets, incident_patch, ends, n_vertices, corner)
+    if extra_corners is not None:
+        corner |= extra_corners
+    degree = np.bincount(ends.reshape(-1), minlength=n_vertices)
+    corner &= degree > 0
+    a, b = _through_pairs(ends, signature, n_vertices, corner)
+    rank = _vertex_rank(points, np.flatnonzero(degree > 0), n_vertices)
+    n = int(ends.shape[0])
+    component = _edge_components(a, b, n)
+    if _corner_closed_chains(ends, component, rank, corner):
+        a, b = _through_pairs(ends, signature, n_vertices, corner)
+        component = _edge_components(a, b, n)
+    return _Links(corner=corner, rank=rank, a=a, b=b, component=component)
+
+
+def _chain_heads(ends: IntArray, links: _Links) -> tuple[IntArray, IntArray]:
+    """Head edge of each chain, at its lowest corner (ties: the lower other vertex), and that
+    corner."""
+    n = int(ends.shape[0])
+    candidate_edge = np.tile(np.arange(n, dtype=np.int64), 2)
+    candidate_vertex = ends.T.reshape(-1)
+    at_corner = links.corner[candidate_vertex]
+    candidate_edge, candidate_vertex = candidate_edge[at_corner], candidate_vertex[at_corner]
+    other = ends[candidate_edge].sum(axis=1) - candidate_vertex
+    candidate_component = links.component[candidate_edge]
+    order = np.lexsort((links.rank[other], links.rank[candidate_vertex], candidate_component))
+    first = np.ones(order.shape[0], dtype=np.bool_)
+    first[1:] = candidate_component[order][1:] != candidate_component[order][:-1]
+    return candidate_edge[order][first], candidate_vertex[order][first]
+
+
+def _walk_chains(links: _Links, heads: IntArray, n: int) -> IntArray:
+    """The ``n`` arc edges chain after chain, each chain in order from its head.
+
+    A depth-first walk from a virtual root tied to every head lists each chain in order.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import depth_first_order
+
+    root = n
+    rows = np.concatenate([links.a, np.full(heads.shape[0], root, dtype=np.int64)])
+    cols = np.concatenate([links.b, heads])
+    graph = coo_matrix((np.ones(rows.shape[0], np.int8), (rows, cols)), shape=(n + 1, n + 1))
+    walk = depth_first_order(graph.tocsr(), root, directed=False, return_predecessors=False)
+    ordered = np.asarray(walk[1:], dtype=np.int64)
+    if ordered.shape[0] != n:  # pragma: no cover - every chain has a head
+        raise TopologyError("arc reconstruction failed: a chain does not end at a corner")
+    return ordered
+
+
+@dataclass(frozen=True)
+class _Walk:
+    """Arc edges in walk order, split into arcs, each edge directed along its arc."""
+
+    ordered: IntArray  # arc-edge positions in walk order
+    arc: IntArray  # arc of each ordered edge
+    arc_offsets: IntArray
+    start: IntArray
+    end: IntArray
+    last: IntArray  # position of each arc's last edge
+
+
+def _direct_edges(
+    ends: IntArray, ordered: IntArray, component: IntArray, heads: IntArray, head_vertex: IntArray
+) -> _Walk:
+    """Split the walk into arcs and direct every edge along its arc from the arc's head."""
+    n = int(ordered.shape[0])
+    chain_of = component[ordered]
+    new_chain = np.ones(n, dtype=np.bool_)
+    new_chain[1:] = chain_of[1:] != chain_of[:-1]
+    arc = np.cumsum(new_chain) - 1
+    arc_offsets = np.append(np.flatnonzero(new_chain), n).astype(np.int64)
+    head_of_component = np.empty(int(component.max()) + 1, dtype=np.int64)
+    head_of_component[component[heads]] = head_vertex
+
+    p, q = ends[ordered, 0], ends[ordered, 1]
+    start = np.empty(n, dtype=np.int64)
+    end = np.empty(n, dtype=np.int64)
+    has_next = np.zeros(n, dtype=np.bool_)
+    has_next[:-1] = arc[1:] == arc[:-1]
+    k = np.flatnonzero(has_next)
+    p_shared = (p[k] == p[k + 1]) | (p[k] == q[k + 1])
+    end[k] = np.where(p_shared, p[k], q[k])
+    start[k] = np.where(p_shared, q[k], p[k])
+    last = np.flatnonzero(~has_next)
+    single = arc_offsets[arc[last]] == last
+    previous_end = end[np.maximum(last - 1, 0)]
+    start[last] = np.where(single, head_of_component[chain_of[last]], previous_end)
+    end[last] = p[last] + q[last] - start[last]
+    return _Walk(ordered, arc, arc_offsets, start, end, last)
+
+
+def _chain_vertices(walk: _Walk) -> tuple[IntArray, IntArray]:
+    """Vertices of every arc in order (its edges' starts, then its last end) and their CSR
+    offsets."""
+    n = int(walk.ordered.shape[0])
+    n_arcs = walk.arc_offsets.shape[0] - 1
+    chain_offsets = walk.arc_offsets + np.arange(n_arcs + 1, dtype=np.int64)
+    chain = np.empty(n + n_arcs, dtype=np.int64)
+    chain[np.arange(n) + walk.arc] = walk.start
+    chain[walk.last + walk.arc[walk.last] + 1] = walk.end[walk.last]
+    return chain, chain_offsets
+
+
+def _number_corners(
+    links: _Links, walk: _Walk, n_vertices: int
+) -> tuple[IntArray, IntArray, IntArray]:
+    """Corner vertices in (x, y, z) order and the start and end corner (index) of every arc."""
+    corner_vertices = np.flatnonzero(links.corner)
+    corners = corner_vertices[np.argsort(links.rank[corner_vertices], kind="stable")].astype(
+        np.int64
+    )
+    corner_index = np.full(n_vertices, -1, dtype=np.int64)
+    corner_index[corners] = np.arange(corners.shape[0], dtype=np.int64)
+    arc_start = corner_index[walk.start[walk.arc_offsets[:-1]]]
+    arc_end = corner_index[walk.end[walk.last]]
+    if (arc_start < 0).any() or (arc_end < 0).any():  # pragma: no cover - heads are corners
+        raise TopologyError("arc reconstruction failed: a chain does not end at a corner")
+    return corners, arc_start, arc_end
+
+
 def chain_arc_edges(
     edges: IntArray,
     offsets: IntArray,
@@ -243,114 +417,30 @@ def chain_arc_edges(
     >>> chains.n_arcs, chains.corners.tolist()  # one closed border, cornered at vertex 0
     (1, [0])
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components, depth_first_order
-
     arc_edges = np.asarray(arc_edges, dtype=np.int64)
     n = int(arc_edges.shape[0])
     if n == 0:
         return _empty_chains()
     ends = edges[arc_edges]
     signature = _multiset_signatures(offsets, incident_patch, arc_edges)
-    corner = np.zeros(n_vertices, dtype=np.bool_)
-    _touch_corners(edges, offsets, incident_patch, ends, n_vertices, corner)
-    if extra_corners is not None:
-        corner |= extra_corners
-    degree = np.bincount(ends.reshape(-1), minlength=n_vertices)
-    corner &= degree > 0
-    a, b = _through_pairs(ends, signature, n_vertices, corner)
-    rank = _vertex_rank(points, np.flatnonzero(degree > 0), n_vertices)
-
-    def components(a: IntArray, b: IntArray) -> IntArray:
-        graph = coo_matrix((np.ones(a.shape[0], np.int8), (a, b)), shape=(n, n))
-        labels: IntArray = connected_components(graph, directed=False)[1].astype(np.int64)
-        return labels
-
-    component = components(a, b)
-    # Rule 5: closed chains with no corner get their lowest vertex as one.
-    n_components = int(component.max()) + 1
-    touches = (corner[ends[:, 0]] | corner[ends[:, 1]]).astype(np.float64)
-    closed = np.flatnonzero(np.bincount(component, weights=touches, minlength=n_components) == 0)
-    if closed.size:
-        lowest = np.full(n_components, np.iinfo(np.int64).max, dtype=np.int64)
-        np.minimum.at(lowest, component, np.minimum(rank[ends[:, 0]], rank[ends[:, 1]]))
-        by_rank = np.empty(int(rank.max()) + 1, dtype=np.int64)
-        by_rank[rank[rank >= 0]] = np.flatnonzero(rank >= 0)
-        corner[by_rank[lowest[closed]]] = True
-        a, b = _through_pairs(ends, signature, n_vertices, corner)
-        component = components(a, b)
-        n_components = int(component.max()) + 1
-
-    # Head of each chain: its edge at its lowest corner (ties: the lower other vertex).
-    candidate_edge = np.tile(np.arange(n, dtype=np.int64), 2)
-    candidate_vertex = ends.T.reshape(-1)
-    at_corner = corner[candidate_vertex]
-    candidate_edge, candidate_vertex = candidate_edge[at_corner], candidate_vertex[at_corner]
-    other = ends[candidate_edge].sum(axis=1) - candidate_vertex
-    candidate_component = component[candidate_edge]
-    order = np.lexsort((rank[other], rank[candidate_vertex], candidate_component))
-    first = np.ones(order.shape[0], dtype=np.bool_)
-    first[1:] = candidate_component[order][1:] != candidate_component[order][:-1]
-    heads = candidate_edge[order][first]
-    head_vertex = candidate_vertex[order][first]
-
-    # A depth-first walk from a virtual root tied to every head lists each chain in order.
-    root = n
-    rows = np.concatenate([a, np.full(heads.shape[0], root, dtype=np.int64)])
-    cols = np.concatenate([b, heads])
-    graph = coo_matrix((np.ones(rows.shape[0], np.int8), (rows, cols)), shape=(n + 1, n + 1))
-    walk = depth_first_order(graph.tocsr(), root, directed=False, return_predecessors=False)
-    ordered = np.asarray(walk[1:], dtype=np.int64)
-    if ordered.shape[0] != n:  # pragma: no cover - every chain has a head
-        raise TopologyError("arc reconstruction failed: a chain does not end at a corner")
-    chain_of = component[ordered]
-    new_chain = np.ones(n, dtype=np.bool_)
-    new_chain[1:] = chain_of[1:] != chain_of[:-1]
-    arc = np.cumsum(new_chain) - 1
-    arc_offsets = np.append(np.flatnonzero(new_chain), n).astype(np.int64)
-    head_of_component = np.empty(n_components, dtype=np.int64)
-    head_of_component[component[heads]] = head_vertex
-
-    # Direction of every edge along its arc.
-    p, q = ends[ordered, 0], ends[ordered, 1]
-    start = np.empty(n, dtype=np.int64)
-    end = np.empty(n, dtype=np.int64)
-    has_next = np.zeros(n, dtype=np.bool_)
-    has_next[:-1] = arc[1:] == arc[:-1]
-    k = np.flatnonzero(has_next)
-    p_shared = (p[k] == p[k + 1]) | (p[k] == q[k + 1])
-    end[k] = np.where(p_shared, p[k], q[k])
-    start[k] = np.where(p_shared, q[k], p[k])
-    last = np.flatnonzero(~has_next)
-    single = arc_offsets[arc[last]] == last
-    previous_end = end[np.maximum(last - 1, 0)]
-    start[last] = np.where(single, head_of_component[chain_of[last]], previous_end)
-    end[last] = p[last] + q[last] - start[last]
-
-    n_arcs = arc_offsets.shape[0] - 1
-    chain_offsets = arc_offsets + np.arange(n_arcs + 1, dtype=np.int64)
-    chain = np.empty(n + n_arcs, dtype=np.int64)
-    chain[np.arange(n) + arc] = start
-    chain[last + arc[last] + 1] = end[last]
-
-    corner_vertices = np.flatnonzero(corner)
-    corners = corner_vertices[np.argsort(rank[corner_vertices], kind="stable")].astype(np.int64)
-    corner_index = np.full(n_vertices, -1, dtype=np.int64)
-    corner_index[corners] = np.arange(corners.shape[0], dtype=np.int64)
-    arc_start = corner_index[start[arc_offsets[:-1]]]
-    arc_end = corner_index[end[last]]
-    if (arc_start < 0).any() or (arc_end < 0).any():  # pragma: no cover - heads are corners
-        raise TopologyError("arc reconstruction failed: a chain does not end at a corner")
+    links = _find_corners(
+        edges, offsets, incident_patch, ends, signature, n_vertices, points, extra_corners
+    )
+    heads, head_vertex = _chain_heads(ends, links)
+    ordered = _walk_chains(links, heads, n)
+    walk = _direct_edges(ends, ordered, links.component, heads, head_vertex)
+    chain, chain_offsets = _chain_vertices(walk)
+    corners, arc_start, arc_end = _number_corners(links, walk, n_vertices)
 
     # Arcs listed by (start corner, end corner, rank of the second point).
-    second = rank[chain[chain_offsets[:-1] + 1]]
+    second = links.rank[chain[chain_offsets[:-1] + 1]]
     perm = np.lexsort((second, arc_end, arc_start)).astype(np.int64)
-    arc_offsets, edge_gather = _permute_rows(arc_offsets, perm)
+    arc_offsets, edge_gather = _permute_rows(walk.arc_offsets, perm)
     chain_offsets, chain_gather = _permute_rows(chain_offsets, perm)
     return ArcChains(
         edge_ids=arc_edges[ordered][edge_gather],
-        edge_start=start[edge_gather],
-        edge_end=end[edge_gather],
+        edge_start=walk.start[edge_gather],
+        edge_end=walk.end[edge_gather],
         arc_offsets=arc_offsets,
         chain_vertices=chain[chain_gather],
         chain_offsets=chain_offsets,
