@@ -140,6 +140,153 @@ def _subdivide(p: NDArray[np.float64], q: NDArray[np.float64], step: float) -> N
     return points
 
 
+@dataclass(frozen=True)
+class _Faulting:
+    """Layout of the section: horizon levels at x = 0, their dip, the fault and its throw."""
+
+    levels: list[float]
+    dip: float
+    fault_top: float
+    fault_slope: float
+    throw: float
+
+
+def _faulting(n_horizons: int, width: float, height: float, throw: float) -> _Faulting:
+    """Evenly spaced dipping horizons and a normal fault through the box (checks the throw)."""
+    spacing = height / (n_horizons + 1)
+    dip = -0.05
+    fault_top, fault_slope = 0.55 * width, 0.3
+    levels = [-spacing * (i + 1) + 0.25 * spacing for i in range(n_horizons)]
+    lowest = min([lv - throw + dip * width for lv in levels], default=0.0)
+    if lowest <= -height or throw >= spacing * 0.75:
+        raise ValueError("throw too large for the layer thickness")
+    return _Faulting(levels, dip, fault_top, fault_slope, throw)
+
+
+#: Vertices and triangles of each patch of one surface, before merging.
+_Parts = tuple[list[NDArray[np.float64]], list[NDArray[np.int64]]]
+
+
+def _strip_parts(
+    edge_points: list[NDArray[np.float64]], edges: list[int], ys: NDArray[np.float64]
+) -> _Parts:
+    """One patch per section edge: the edge's polyline extruded along y at ``ys``."""
+    n_y = ys.shape[0] - 1
+    vertex_parts: list[NDArray[np.float64]] = []
+    face_parts: list[NDArray[np.int64]] = []
+    for edge in edges:
+        line = edge_points[edge]
+        n_s = len(line)
+        grid = np.empty((n_y + 1, n_s, 3))
+        grid[:, :, 0] = line[None, :, 0]
+        grid[:, :, 1] = ys[:, None]
+        grid[:, :, 2] = line[None, :, 1]
+        i, j = np.meshgrid(np.arange(n_s - 1), np.arange(n_y), indexing="xy")
+        a = (j * n_s + i).ravel()
+        quads = np.stack([a, a + 1, a + 1 + n_s, a + n_s], axis=1)
+        vertex_parts.append(grid.reshape(-1, 3))
+        face_parts.append(np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]]))
+    return vertex_parts, face_parts
+
+
+def _cap_parts(
+    cells: list[list[tuple[int, int]]],
+    edge_points: list[NDArray[np.float64]],
+    at_y: float,
+    flip: bool,
+) -> _Parts:
+    """One patch per section cell: a fan about its centre in the plane y = ``at_y``."""
+    vertex_parts: list[NDArray[np.float64]] = []
+    face_parts: list[NDArray[np.int64]] = []
+    for cycle in cells:
+        ring = np.concatenate(
+            [(edge_points[e] if d == 1 else edge_points[e][::-1])[:-1] for e, d in cycle]
+        )
+        centre = ring.mean(axis=0)
+        k = len(ring)
+        fan = np.stack(
+            [np.zeros(k, np.int64), np.arange(1, k + 1), np.roll(np.arange(k), -1) + 1], axis=1
+        )
+        xyz = np.column_stack(
+            [np.r_[centre[0], ring[:, 0]], np.full(k + 1, at_y), np.r_[centre[1], ring[:, 1]]]
+        )
+        vertex_parts.append(xyz)
+        face_parts.append(fan[:, ::-1] if flip else fan)
+    return vertex_parts, face_parts
+
+
+@dataclass(frozen=True)
+class _Fold:
+    """The volume-preserving fold ``z += A sin(πx/X) sin(πy/Y)``, then the shift to ``origin``."""
+
+    amplitude: float
+    width: float
+    length: float
+    origin: tuple[float, float, float]
+
+    def __call__(self, xyz: NDArray[np.float64]) -> NDArray[np.float64]:
+        out = xyz.copy()
+        out[:, 2] += (
+            self.amplitude
+            * np.sin(np.pi * xyz[:, 0] / self.width)
+            * np.sin(np.pi * xyz[:, 1] / self.length)
+        )
+        return np.asarray(out + np.asarray(self.origin), dtype=np.float64)
+
+
+def _surfaces(
+    builders: dict[str, _Parts],
+    strip_surfaces: dict[str, list[int]],
+    n_cells: int,
+    n_horizons: int,
+    fold: _Fold,
+) -> tuple[list[Surface], dict[int, tuple[int, int]]]:
+    """The folded surfaces (ids in ``builders`` order) and the (surface, patch) of each edge."""
+    kinds = {"fault": "fault", **{f"H{i}": "horizon" for i in range(1, n_horizons + 1)}}
+    entities: list[Surface] = []
+    patch_of_edge: dict[int, tuple[int, int]] = {}
+    for surface_id, (surface, (vertex_parts, face_parts)) in enumerate(builders.items()):
+        offsets = np.cumsum([0] + [len(v) for v in vertex_parts])
+        faces = np.concatenate([f + o for f, o in zip(face_parts, offsets, strict=False)])
+        labels = np.concatenate([np.full(len(f), k) for k, f in enumerate(face_parts)])
+        merged, inverse = mesh.merge_close_vertices(np.concatenate(vertex_parts), 0.0)
+        if surface in strip_surfaces:
+            names = tuple(f"{surface}:{k}" for k in range(len(face_parts)))
+            for k, edge in enumerate(strip_surfaces[surface]):
+                patch_of_edge[edge] = (surface_id, k)
+        else:
+            names = tuple(f"{surface}:cell{k}" for k in range(n_cells))
+        entities.append(
+            Surface(
+                id=surface_id,
+                name=surface,
+                kind=kinds.get(surface, "boundary"),
+                vertices=fold(merged),
+                faces=inverse[faces],
+                patch_labels=labels,
+                patch_names=names,
+            )
+        )
+    return entities, patch_of_edge
+
+
+def _cell_names(
+    cells: list[list[tuple[int, int]]],
+    edge_points: list[NDArray[np.float64]],
+    faulting: _Faulting,
+) -> list[tuple[str, int]]:
+    """(side of the fault, layer number) of every cell, from its centre."""
+    cell_names = []
+    for cycle in cells:
+        ring = np.concatenate([edge_points[e] for e, _ in cycle])
+        cx, cz = ring.mean(axis=0)
+        hanging = cx > faulting.fault_top + faulting.fault_slope * cz
+        shift = faulting.throw if hanging else 0.0
+        layer = 1 + sum(1 for level in faulting.levels if level - shift + faulting.dip * cx > cz)
+        cell_names.append(("hanging wall" if hanging else "footwall", layer))
+    return cell_names
+
+
 def faulted_layer_cake(
     n_horizons: int = 2,
     resolution: float = 50.0,
@@ -166,99 +313,25 @@ def faulted_layer_cake(
         raise ValueError("n_horizons must be ≥ 0")
     if not resolution > 0:
         raise ValueError("resolution must be > 0")
-    spacing = height / (n_horizons + 1)
-    dip = -0.05
-    fault_top, fault_slope = 0.55 * width, 0.3
-    levels = [-spacing * (i + 1) + 0.25 * spacing for i in range(n_horizons)]
-    lowest = min([lv - throw + dip * width for lv in levels], default=0.0)
-    if lowest <= -height or throw >= spacing * 0.75:
-        raise ValueError("throw too large for the layer thickness")
-    section = _section(width, height, levels, dip, fault_top, fault_slope, throw)
+    f = _faulting(n_horizons, width, height, throw)
+    section = _section(width, height, f.levels, f.dip, f.fault_top, f.fault_slope, throw)
     cells = _cells(section)
     pts = np.asarray(section.points)
     edge_points = [_subdivide(pts[a], pts[b], resolution) for _, a, b in section.edges]
     n_y = max(1, math.ceil(length / resolution))
     ys = np.linspace(0.0, length, n_y + 1)
 
-    def fold(xyz: NDArray[np.float64]) -> NDArray[np.float64]:
-        out = xyz.copy()
-        out[:, 2] += (
-            fold_amplitude * np.sin(np.pi * xyz[:, 0] / width) * np.sin(np.pi * xyz[:, 1] / length)
-        )
-        return np.asarray(out + np.asarray(origin), dtype=np.float64)
-
     # -- surfaces: one patch per section edge (strips) or per cell (south/north faces) --------
     strip_surfaces: dict[str, list[int]] = defaultdict(list)  # surface -> its edges, in order
     for edge, (surface, _, _) in enumerate(section.edges):
         strip_surfaces[surface].append(edge)
-
-    builders: dict[str, tuple[list[NDArray[np.float64]], list[NDArray[np.int64]]]] = {}
-    for surface, edges in strip_surfaces.items():
-        vertex_parts, face_parts = [], []
-        for edge in edges:
-            line = edge_points[edge]
-            n_s = len(line)
-            grid = np.empty((n_y + 1, n_s, 3))
-            grid[:, :, 0] = line[None, :, 0]
-            grid[:, :, 1] = ys[:, None]
-            grid[:, :, 2] = line[None, :, 1]
-            i, j = np.meshgrid(np.arange(n_s - 1), np.arange(n_y), indexing="xy")
-            a = (j * n_s + i).ravel()
-            quads = np.stack([a, a + 1, a + 1 + n_s, a + n_s], axis=1)
-            vertex_parts.append(grid.reshape(-1, 3))
-            face_parts.append(np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]]))
-        builders[surface] = (vertex_parts, face_parts)
-    for face_name, at_y, flip in (("south", 0.0, False), ("north", length, True)):
-        vertex_parts, face_parts = [], []
-        for cycle in cells:
-            ring = np.concatenate(
-                [(edge_points[e] if d == 1 else edge_points[e][::-1])[:-1] for e, d in cycle]
-            )
-            centre = ring.mean(axis=0)
-            k = len(ring)
-            fan = np.stack(
-                [np.zeros(k, np.int64), np.arange(1, k + 1), np.roll(np.arange(k), -1) + 1], axis=1
-            )
-            xyz = np.column_stack(
-                [np.r_[centre[0], ring[:, 0]], np.full(k + 1, at_y), np.r_[centre[1], ring[:, 1]]]
-            )
-            vertex_parts.append(xyz)
-            face_parts.append(fan[:, ::-1] if flip else fan)
-        builders[face_name] = (vertex_parts, face_parts)
-
-    kinds = {"fault": "fault", **{f"H{i}": "horizon" for i in range(1, n_horizons + 1)}}
-    entities: list[Surface] = []
-    patch_of_edge: dict[int, tuple[int, int]] = {}
-    for surface_id, (surface, (vertex_parts, face_parts)) in enumerate(builders.items()):
-        offsets = np.cumsum([0] + [len(v) for v in vertex_parts])
-        faces = np.concatenate([f + o for f, o in zip(face_parts, offsets, strict=False)])
-        labels = np.concatenate([np.full(len(f), k) for k, f in enumerate(face_parts)])
-        merged, inverse = mesh.merge_close_vertices(np.concatenate(vertex_parts), 0.0)
-        if surface in strip_surfaces:
-            names = tuple(f"{surface}:{k}" for k in range(len(face_parts)))
-            for k, edge in enumerate(strip_surfaces[surface]):
-                patch_of_edge[edge] = (surface_id, k)
-        else:
-            names = tuple(f"{surface}:cell{k}" for k in range(len(cells)))
-        entities.append(
-            Surface(
-                id=surface_id,
-                name=surface,
-                kind=kinds.get(surface, "boundary"),
-                vertices=fold(merged),
-                faces=inverse[faces],
-                patch_labels=labels,
-                patch_names=names,
-            )
-        )
-    cell_names = []
-    for cycle in cells:
-        ring = np.concatenate([edge_points[e] for e, _ in cycle])
-        cx, cz = ring.mean(axis=0)
-        hanging = cx > fault_top + fault_slope * cz
-        shift = throw if hanging else 0.0
-        layer = 1 + sum(1 for level in levels if level - shift + dip * cx > cz)
-        cell_names.append(("hanging wall" if hanging else "footwall", layer))
+    builders = {
+        surface: _strip_parts(edge_points, edges, ys) for surface, edges in strip_surfaces.items()
+    }
+    builders["south"] = _cap_parts(cells, edge_points, 0.0, flip=False)
+    builders["north"] = _cap_parts(cells, edge_points, length, flip=True)
+    fold = _Fold(fold_amplitude, width, length, origin)
+    entities, patch_of_edge = _surfaces(builders, strip_surfaces, len(cells), n_horizons, fold)
     return _with_topology(
         entities,
         section,
@@ -266,7 +339,95 @@ def faulted_layer_cake(
         patch_of_edge,
         origin,
         n_horizons,
-        cell_names,
+        _cell_names(cells, edge_points, f),
+    )
+
+
+@dataclass
+class _BlockSides:
+    """Positive and negative block of every patch (by patch id) and the sides of every block."""
+
+    patch_ids: dict[tuple[int, int], int]
+    positive: dict[int, int] = field(default_factory=dict)
+    negative: dict[int, int] = field(default_factory=dict)
+    sides: dict[int, list[PatchSide]] = field(default_factory=lambda: defaultdict(list))
+
+    def assign(self, patch: int, side: int, block: int) -> None:
+        (self.positive if side == 1 else self.negative)[patch] = block
+        self.sides[block].append(PatchSide(patch, 1 if side == 1 else -1))
+
+
+def _block_sides(
+    surfaces: list[Surface],
+    section: _Section,
+    cells: list[list[tuple[int, int]]],
+    patch_of_edge: dict[int, tuple[int, int]],
+    block_ids: list[int],
+    universe_id: int,
+) -> _BlockSides:
+    """Each cell's block bounded by its edges' strips and its south/north caps; the universe
+    by the section's border strips and the caps' other sides."""
+    by_name = {s.name: s for s in surfaces}
+    patch_ids: dict[tuple[int, int], int] = {}
+    for surface in surfaces:
+        for label in range(surface.n_patches):
+            patch_ids[(int(surface.id or 0), label)] = len(patch_ids)
+    sides = _BlockSides(patch_ids)
+    edge_cells: dict[int, list[tuple[int, int]]] = defaultdict(list)
+    for cell, cycle in enumerate(cells):
+        for edge, direction in cycle:
+            edge_cells[edge].append((cell, direction))
+            sides.assign(patch_ids[patch_of_edge[edge]], direction, block_ids[cell])
+        for face_name in ("south", "north"):
+            sides.assign(patch_ids[(int(by_name[face_name].id or 0), cell)], -1, block_ids[cell])
+    for edge in range(len(section.edges)):
+        if len(edge_cells[edge]) == 1:
+            sides.assign(patch_ids[patch_of_edge[edge]], -edge_cells[edge][0][1], universe_id)
+    for face_name in ("south", "north"):
+        for cell in range(len(cells)):
+            sides.assign(patch_ids[(int(by_name[face_name].id or 0), cell)], 1, universe_id)
+    return sides
+
+
+def _blocks(
+    block_ids: list[int],
+    universe_id: int,
+    cell_names: list[tuple[str, int]],
+    sides: _BlockSides,
+) -> list[Block]:
+    """One block per cell, named by side of the fault and layer; then the universe."""
+    blocks = [
+        Block(
+            id=block_id,
+            name=f"{side} unit {layer}",
+            unit_name=f"unit {layer}",
+            sides=tuple(sides.sides[block_id]),
+            metadata={"fault_side": side, "layer": layer},
+        )
+        for block_id, (side, layer) in zip(block_ids, cell_names, strict=True)
+    ]
+    blocks.append(
+        Block(
+            id=universe_id,
+            name="universe",
+            kind=UNIVERSE_KIND,
+            sides=tuple(sides.sides[universe_id]),
+        )
+    )
+    return blocks
+
+
+def _groups(surfaces: list[Surface], blocks: list[Block]) -> tuple[Group, ...]:
+    """The horizons, faults, boundaries and blocks groups."""
+
+    def of_kind(kind: str) -> tuple[int, ...]:
+        return tuple(int(s.id or 0) for s in surfaces if s.kind == kind)
+
+    return (
+        Group(name="horizons", kind="horizons", members=of_kind("horizon")),
+        Group(name="faults", kind="faults", members=of_kind("fault")),
+        Group(name="boundaries", kind="boundaries", members=of_kind("boundary")),
+        Group(name="blocks", kind="blocks", members=tuple(b.id or 0 for b in blocks)),
     )
 
 
@@ -279,92 +440,31 @@ def _with_topology(
     n_horizons: int,
     cell_names: list[tuple[str, int]],
 ) -> Scene:
-    by_name = {s.name: s for s in surfaces}
+    """The scene of ``surfaces`` with its blocks, patches, corners and arcs."""
     next_id = len(surfaces)
-    # Blocks: one per cell, named by side of the fault and layer; then the universe.
     block_ids = list(range(next_id, next_id + len(cells)))
     universe_id = next_id + len(cells)
-    patch_ids: dict[tuple[int, int], int] = {}
-    for surface in surfaces:
-        for label in range(surface.n_patches):
-            patch_ids[(int(surface.id or 0), label)] = len(patch_ids)
-    positive: dict[int, int] = {}
-    negative: dict[int, int] = {}
-    block_sides: dict[int, list[PatchSide]] = defaultdict(list)
-
-    def assign(patch: int, side: int, block: int) -> None:
-        (positive if side == 1 else negative)[patch] = block
-        block_sides[block].append(PatchSide(patch, 1 if side == 1 else -1))
-
-    edge_cells: dict[int, list[tuple[int, int]]] = defaultdict(list)
-    for cell, cycle in enumerate(cells):
-        for edge, direction in cycle:
-            edge_cells[edge].append((cell, direction))
-            assign(patch_ids[patch_of_edge[edge]], direction, block_ids[cell])
-        for face_name in ("south", "north"):
-            assign(patch_ids[(int(by_name[face_name].id or 0), cell)], -1, block_ids[cell])
-    for edge in range(len(section.edges)):
-        if len(edge_cells[edge]) == 1:
-            assign(patch_ids[patch_of_edge[edge]], -edge_cells[edge][0][1], universe_id)
-    for face_name in ("south", "north"):
-        for cell in range(len(cells)):
-            assign(patch_ids[(int(by_name[face_name].id or 0), cell)], 1, universe_id)
-
+    sides = _block_sides(surfaces, section, cells, patch_of_edge, block_ids, universe_id)
     patches = [
         Patch(
             id=pid,
             surface=sid,
             label=label,
             name=by_name_label(surfaces, sid, label),
-            positive_block=positive.get(pid),
-            negative_block=negative.get(pid),
+            positive_block=sides.positive.get(pid),
+            negative_block=sides.negative.get(pid),
         )
-        for (sid, label), pid in patch_ids.items()
+        for (sid, label), pid in sides.patch_ids.items()
     ]
     # Corners and arcs by geobrep's one rule (geobrep.model.arcs), as readers and the builder
     # find them.
     corners, arcs, patch_arcs = corners_and_arcs({int(s.id or 0): s for s in surfaces}, patches)
     patches = [p.model_copy(update={"arcs": tuple(patch_arcs.get(p.id, ()))}) for p in patches]
-    blocks = [
-        Block(
-            id=block_id,
-            name=f"{side} unit {layer}",
-            unit_name=f"unit {layer}",
-            sides=tuple(block_sides[block_id]),
-            metadata={"fault_side": side, "layer": layer},
-        )
-        for block_id, (side, layer) in zip(block_ids, cell_names, strict=True)
-    ]
-    blocks.append(
-        Block(
-            id=universe_id,
-            name="universe",
-            kind=UNIVERSE_KIND,
-            sides=tuple(block_sides[universe_id]),
-        )
-    )
-    groups = (
-        Group(
-            name="horizons",
-            kind="horizons",
-            members=tuple(int(s.id or 0) for s in surfaces if s.kind == "horizon"),
-        ),
-        Group(
-            name="faults",
-            kind="faults",
-            members=tuple(int(s.id or 0) for s in surfaces if s.kind == "fault"),
-        ),
-        Group(
-            name="boundaries",
-            kind="boundaries",
-            members=tuple(int(s.id or 0) for s in surfaces if s.kind == "boundary"),
-        ),
-        Group(name="blocks", kind="blocks", members=tuple(b.id or 0 for b in blocks)),
-    )
+    blocks = _blocks(block_ids, universe_id, cell_names, sides)
     return Scene(
         name="faulted layer cake",
         entities=[*surfaces, *blocks],
-        groups=groups,
+        groups=_groups(surfaces, blocks),
         crs=CRS(epsg=32631, name="WGS 84 / UTM zone 31N"),
         topology=Topology(corners=tuple(corners), arcs=tuple(arcs), patches=tuple(patches)),
         metadata={

@@ -26,7 +26,7 @@ from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.glyphs import ADVANCE, CAP_HEIGHT, DESCENDER, WIDTH, text_strokes
 from geobrep.plugins.clip.lines import cut_segments
 from geobrep.plugins.clip.options import AnnotationClipOptions, tolerance_of
-from geobrep.plugins.clip.sides import signed_distances, vertex_sides
+from geobrep.plugins.clip.sides import vertex_sides
 
 __all__ = ["annotation_polyline", "annotation_strokes", "clip_annotation"]
 
@@ -104,7 +104,7 @@ def clip_annotation(
             parts[side] = annotation if side_of_anchor != -side else None
         else:
             corners = _cells(annotation)
-            sides = vertex_sides(signed_distances(corners.reshape(-1, 3), plane), tolerance)
+            sides = vertex_sides(plane.signed_distance(corners.reshape(-1, 3)), tolerance)
             inside = (sides.reshape(-1, 4) != -side).all(axis=1)
             if options.precision == "string":
                 parts[side] = annotation if inside.all() else None
@@ -146,7 +146,7 @@ def _by_stroke(
     last_of_stroke[starts + lengths - 1] = True
     first = first[~last_of_stroke[:-1]]
     segments = np.stack([first, first + 1], axis=1)
-    distances = signed_distances(points, plane)
+    distances = plane.signed_distance(points)
     if (vertex_sides(distances, tolerance) != -side).all():
         kept_uv = strokes
     else:

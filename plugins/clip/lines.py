@@ -24,7 +24,6 @@ from geobrep.plugins.clip.options import ClipOptions, tolerance_of
 from geobrep.plugins.clip.sides import (
     crossing_points,
     interpolate_properties,
-    signed_distances,
     vertex_sides,
 )
 
@@ -185,7 +184,7 @@ def clip_polyline(
 ) -> Any:
     """Clipper of :class:`PolyLine` entities (see the module docstring)."""
     tolerance = tolerance_of(options, context)
-    distances = signed_distances(line.vertices, plane)
+    distances = plane.signed_distance(line.vertices)
     sides = vertex_sides(distances, tolerance)
     parts: dict[int, PolyLine | None] = {}
     for side in halves(keep):
@@ -226,7 +225,7 @@ def section_polyline(
 ) -> PointSet | None:
     """Where a line meets the plane: crossing points and vertices on the plane."""
     tolerance = tolerance_of(options, context)
-    distances = signed_distances(line.vertices, plane)
+    distances = plane.signed_distance(line.vertices)
     sides = vertex_sides(distances, tolerance)
     segments = np.asarray(line.segments, dtype=np.int64)
     crossing = np.flatnonzero(sides[segments[:, 0]] * sides[segments[:, 1]] < 0)

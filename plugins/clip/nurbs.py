@@ -17,7 +17,7 @@ from geobrep.geometry import Plane
 from geobrep.model.entities import NurbsSurface, Surface
 from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.options import NurbsClipOptions, SurfaceClipOptions, tolerance_of
-from geobrep.plugins.clip.sides import signed_distances, vertex_sides
+from geobrep.plugins.clip.sides import vertex_sides
 from geobrep.plugins.clip.surfaces import clip_surface
 
 __all__ = ["clip_nurbs", "trimmed_mesh"]
@@ -55,7 +55,7 @@ def clip_nurbs(
     """Clipper of :class:`NurbsSurface` entities (see the module docstring)."""
     tolerance = tolerance_of(options, context)
     net = np.asarray(surface.control_points, dtype=np.float64).reshape(-1, 3)
-    net_sides = vertex_sides(signed_distances(net, plane), tolerance)
+    net_sides = vertex_sides(plane.signed_distance(net), tolerance)
     parts: dict[int, NurbsSurface | None] = {}
     mesh: Surface | None = None
     for side in halves(keep):

@@ -11,7 +11,7 @@ from geobrep.geometry import Plane
 from geobrep.model.entities import PointSet
 from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.options import ClipOptions, tolerance_of
-from geobrep.plugins.clip.sides import signed_distances, vertex_sides
+from geobrep.plugins.clip.sides import vertex_sides
 
 __all__ = ["clip_pointset", "section_pointset"]
 
@@ -20,7 +20,7 @@ def clip_pointset(
     points: PointSet, plane: Plane, keep: Keep, options: ClipOptions, context: ClipContext
 ) -> Any:
     """Clipper of :class:`PointSet` entities."""
-    sides = vertex_sides(signed_distances(points.vertices, plane), tolerance_of(options, context))
+    sides = vertex_sides(plane.signed_distance(points.vertices), tolerance_of(options, context))
     parts: dict[int, PointSet | None] = {}
     for side in halves(keep):
         chosen = np.flatnonzero(sides != -side)
@@ -39,7 +39,7 @@ def section_pointset(
     points: PointSet, plane: Plane, options: ClipOptions, context: ClipContext
 ) -> PointSet | None:
     """The points lying on the plane (within the tolerance)."""
-    sides = vertex_sides(signed_distances(points.vertices, plane), tolerance_of(options, context))
+    sides = vertex_sides(plane.signed_distance(points.vertices), tolerance_of(options, context))
     chosen = np.flatnonzero(sides == 0)
     if chosen.shape[0] == 0:
         return None

@@ -25,7 +25,7 @@ from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.caps import group_holes, loop_areas, plane_basis
 from geobrep.plugins.clip.lines import LineCut, cut_segments
 from geobrep.plugins.clip.options import ClipOptions, tolerance_of
-from geobrep.plugins.clip.sides import interpolate_properties, signed_distances, vertex_sides
+from geobrep.plugins.clip.sides import interpolate_properties, vertex_sides
 
 __all__ = ["clip_polygon", "section_polygon"]
 
@@ -77,7 +77,7 @@ def clip_polygon(
 ) -> Any:
     """Clipper of :class:`Polygon` entities (see the module docstring)."""
     tolerance = tolerance_of(options, context)
-    distances = signed_distances(polygon.vertices, plane)
+    distances = plane.signed_distance(polygon.vertices)
     sides = vertex_sides(distances, tolerance)
     parts: dict[int, Polygon | None] = {}
     normals: FloatArray | None = None
@@ -237,7 +237,7 @@ def section_polygon(
     if negative is None or negative is polygon:
         return None
     tolerance = tolerance_of(options, context)
-    on = vertex_sides(signed_distances(negative.vertices, plane), tolerance) == 0
+    on = vertex_sides(plane.signed_distance(negative.vertices), tolerance) == 0
     nxt = np.arange(1, negative.vertices.shape[0] + 1)
     ring = _ring_of_vertex(negative)
     last = nxt == negative.ring_offsets[1:][ring]

@@ -9,13 +9,11 @@ bit, in every entity that holds it (neighbouring surfaces, block boundaries, cap
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.geometry import Plane
 from geobrep.model.properties import Property, PropertyMap
 
 __all__ = [
@@ -25,7 +23,6 @@ __all__ = [
     "crossing_points",
     "interpolate_properties",
     "side_bits",
-    "signed_distances",
     "vertex_sides",
 ]
 
@@ -36,19 +33,6 @@ FloatArray = NDArray[np.float64]
 NEGATIVE_BIT = 1
 #: Bit set in :func:`side_bits` for a point strictly on the positive side.
 POSITIVE_BIT = 2
-
-
-def signed_distances(points: FloatArray, plane: Plane) -> FloatArray:
-    """Signed distances of (N, 3) points to ``plane`` (no validation: entity arrays are valid).
-
-    >>> signed_distances(np.array([[450.0, 0, 0], [449.0, 0, 0]]), Plane.x(450)).tolist()
-    [0.0, -1.0]
-    """
-    length = math.hypot(plane.a, plane.b, plane.c)
-    normal = np.array([plane.a, plane.b, plane.c]) / length
-    if points.shape[0] == 0:
-        return np.zeros(0)
-    return np.asarray(points @ normal + plane.d / length, dtype=np.float64)
 
 
 def vertex_sides(distances: FloatArray, tolerance: float) -> NDArray[np.int8]:

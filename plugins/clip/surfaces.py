@@ -24,7 +24,7 @@ from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.caps import cap_rings, cap_triangles, open_boundary
 from geobrep.plugins.clip.loops import order_paths
 from geobrep.plugins.clip.options import SurfaceClipOptions, tolerance_of
-from geobrep.plugins.clip.sides import interpolate_properties, signed_distances
+from geobrep.plugins.clip.sides import interpolate_properties
 from geobrep.plugins.clip.triangles import HalfMesh, InPlaneRule, TriangleCut, cut_triangles
 
 __all__ = ["SurfaceCut", "clip_surface", "section_surface", "surface_cut"]
@@ -77,7 +77,7 @@ def surface_cut(
         triangles, source = mesh.triangulate(surface.faces)
     else:
         triangles = surface.faces.astype(np.int64, copy=False)
-    distances = signed_distances(surface.vertices, plane)
+    distances = plane.signed_distance(surface.vertices)
     cut = cut_triangles(surface.vertices, triangles, distances, tolerance)
     result = SurfaceCut(surface, source, cut, plane.normal, {})
     context.cache[key] = result
@@ -197,7 +197,7 @@ def _extended(cell_data: PropertyMap, count: int) -> PropertyMap:
 
 
 def _clip_vertices_only(surface: Surface, plane: Plane, keep: Keep, tolerance: float) -> Any:
-    distances = signed_distances(surface.vertices, plane)
+    distances = plane.signed_distance(surface.vertices)
     parts: dict[int, Surface | None] = {}
     for side in halves(keep):
         chosen = np.flatnonzero(distances * side >= -tolerance)
