@@ -111,19 +111,6 @@ def _crs_for_layer(text: str | None, stored: CRS | None) -> CRS | None:
     return parsed
 
 
-def _crs_text(crs: CRS | None) -> str | None:
-    if crs is None:
-        return None
-    if crs.epsg is not None and not crs.vertical_datum:
-        return f"EPSG:{crs.epsg}"
-    from geobrep.gis.crs_ops import CRSError, parse_crs
-
-    try:
-        return str(parse_crs(crs).to_wkt())
-    except CRSError:
-        return crs.wkt or crs.proj
-
-
 _GEOJSON_CRS = re.compile(rb'"crs"\s*:\s*\{.*?"name"\s*:\s*"([^"]+)"', re.DOTALL)
 
 
@@ -336,10 +323,11 @@ def _write_tables(
     crs: CRS | None,
     frames: dict[str, str] | None = None,
 ) -> None:
+    from geobrep.gis.crs_ops import crs_text
+
     pyogrio = _pyogrio()
     shapely = importlib.import_module("shapely")
-
-    crs_text = _crs_text(crs)
+    text = crs_text(crs)
     for position, table in enumerate(tables):
         data, names, masks = _fields(table.columns)
         kwargs: dict[str, Any] = {}
@@ -364,7 +352,7 @@ def _write_tables(
                 layer=table.layer,
                 driver=driver,
                 geometry_type=_geometry_type(table),
-                crs=crs_text if frame is None else None,
+                crs=text if frame is None else None,
                 append=position > 0,
                 promote_to_multi=False,
                 **kwargs,

@@ -50,6 +50,7 @@ if TYPE_CHECKING:
 __all__ = [
     "CRSError",
     "crs_from_user_input",
+    "crs_text",
     "demo_stage",
     "describe_crs",
     "from_geodataframe",
@@ -438,7 +439,20 @@ def _geopandas() -> Any:
     return geopandas
 
 
-def _crs_text(crs: CRS | None) -> str | None:
+def crs_text(crs: CRS | None) -> str | None:
+    """The text a CRS is handed to GDAL or geopandas as: ``"EPSG:n"`` for a plain EPSG CRS,
+    else the WKT pyproj makes of it (a vertical CRS in ``vertical_datum`` compounded in).
+
+    When pyproj cannot read the CRS, the CRS's own WKT or PROJ text as stored: the consumer
+    then says why it cannot use it (the GIS writers raise a FormatError, :func:`to_geodataframe`
+    a :class:`CRSError`) instead of the CRS silently vanishing from what is written. ``None``
+    for no CRS, or one with no text at all (a name pyproj does not know).
+
+    >>> crs_text(CRS(epsg=32631))
+    'EPSG:32631'
+    >>> crs_text(CRS(wkt='FOO["bar"]'))
+    'FOO["bar"]'
+    """
     if crs is None:
         return None
     if crs.epsg is not None and not crs.vertical_datum:
@@ -446,7 +460,15 @@ def _crs_text(crs: CRS | None) -> str | None:
     try:
         return str(parse_crs(crs).to_wkt())
     except CRSError:
-        return None
+        return crs.wkt or crs.proj
+
+
+def _geodataframe(geopandas: Any, data: Any, crs_value: str | None, **kwargs: Any) -> Any:
+    """``geopandas.GeoDataFrame(data, crs=crs_value, ...)``; a CRS it refuses is a CRSError."""
+    try:
+        return geopandas.GeoDataFrame(data, crs=crs_value, **kwargs)
+    except _pyproj().exceptions.CRSError as exc:
+        raise CRSError(f"geopandas cannot use the CRS {str(crs_value)[:60]!r}: {exc}") from exc
 
 
 def to_geodataframe(entities: Scene | Entity | Iterable[Entity], crs: Any = None) -> Any:
@@ -510,13 +532,13 @@ def to_geodataframe(entities: Scene | Entity | Iterable[Entity], crs: Any = None
             else:
                 columns[name] = values
         frames.append(geopandas.GeoDataFrame(columns, geometry=list(table.geometry)))
-    crs_value = _crs_text(as_crs(crs) if crs is not None else (scene.crs if scene else None))
+    crs_value = crs_text(as_crs(crs) if crs is not None else (scene.crs if scene else None))
     if only_plane:
         crs_value = None  # along-section coordinates are in no map CRS
     if not frames:
-        return geopandas.GeoDataFrame({"layer": []}, geometry=[], crs=crs_value)
+        return _geodataframe(geopandas, {"layer": []}, crs_value, geometry=[])
     frame = pandas.concat(frames, ignore_index=True)
-    return geopandas.GeoDataFrame(frame, geometry="geometry", crs=crs_value)
+    return _geodataframe(geopandas, frame, crs_value, geometry="geometry")
 
 
 def from_geodataframe(
