@@ -6,8 +6,8 @@
 (6, 'unit')
 
 Files are read and written through the format registry (``geobrep.read`` / ``geobrep.write``);
-modelling work is done by plugins (``geobrep.plugins``). Optional heavy libraries (open3d,
-pyvista) are imported only by the features that use them.
+modelling work is done by plugins (``geobrep.plugins``). Every public name is imported on first
+use, and optional heavy libraries (open3d, pyvista, pyproj) only by the features that use them.
 """
 
 from __future__ import annotations
@@ -15,7 +15,6 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from geobrep.batch.conversion import ConversionSummary, FileReport, convert
 from geobrep.errors import (
     DegenerateGeometryError,
     EntityNotFoundError,
@@ -29,36 +28,82 @@ from geobrep.errors import (
     TopologyError,
     UnknownFormatError,
 )
-from geobrep.geometry import BoundingBox, Plane
-from geobrep.gis.crs_ops import from_geodataframe, to_geodataframe
-from geobrep.gis.map_products import map_products
-from geobrep.model.crs import CRS
-from geobrep.model.entities import (
-    Annotation,
-    Block,
-    Entity,
-    LinearOctree,
-    NurbsSurface,
-    PatchSide,
-    PointSet,
-    Polygon,
-    PolyLine,
-    Surface,
-    TetMesh,
-)
-from geobrep.model.properties import Property
-from geobrep.model.scene import Group, Scene
-from geobrep.model.topology import Arc, Corner, Patch, Topology
-from geobrep.ops.building import build_blocks
-from geobrep.ops.clipping import clip, clip_box, section
-from geobrep.ops.fitting import FitReport, FitResult, fit
-from geobrep.ops.io import read, write
-from geobrep.ops.voxelization import VoxelizationWarning, voxelize
 
 if TYPE_CHECKING:
     from geobrep import datasets, plugins
-    from geobrep.batch.pipeline import Pipeline
-    from geobrep.batch.pipeline_run import PipelineSummary, run_pipeline
+    from geobrep.batch.conversion import (
+        ConversionSummary,
+        FileReport,
+        convert,
+    )
+    from geobrep.batch.pipeline import (
+        Pipeline,
+    )
+    from geobrep.batch.pipeline_run import (
+        PipelineSummary,
+        run_pipeline,
+    )
+    from geobrep.geometry import (
+        BoundingBox,
+        Plane,
+    )
+    from geobrep.gis.crs_ops import (
+        from_geodataframe,
+        to_geodataframe,
+    )
+    from geobrep.gis.map_products import (
+        map_products,
+    )
+    from geobrep.model.crs import (
+        CRS,
+    )
+    from geobrep.model.entities import (
+        Annotation,
+        Block,
+        Entity,
+        LinearOctree,
+        NurbsSurface,
+        PatchSide,
+        PointSet,
+        Polygon,
+        PolyLine,
+        Surface,
+        TetMesh,
+    )
+    from geobrep.model.properties import (
+        Property,
+    )
+    from geobrep.model.scene import (
+        Group,
+        Scene,
+    )
+    from geobrep.model.topology import (
+        Arc,
+        Corner,
+        Patch,
+        Topology,
+    )
+    from geobrep.ops.building import (
+        build_blocks,
+    )
+    from geobrep.ops.clipping import (
+        clip,
+        clip_box,
+        section,
+    )
+    from geobrep.ops.fitting import (
+        FitReport,
+        FitResult,
+        fit,
+    )
+    from geobrep.ops.io import (
+        read,
+        write,
+    )
+    from geobrep.ops.voxelization import (
+        VoxelizationWarning,
+        voxelize,
+    )
 
 __version__ = "0.1.0"
 
@@ -121,11 +166,50 @@ __all__ = [
 ]
 
 _LAZY_SUBMODULES = {"plugins", "datasets"}
-#: Public names whose modules are imported on first use (their pydantic models take a while).
+#: Where each public name lives; imported on first use, so that `import geobrep` (and
+#: `import geobrep.plugins`, `geobrep.hookspecs`) stays cheap: no numpy, no entity models.
 _LAZY_NAMES = {
+    "Annotation": "geobrep.model.entities",
+    "Arc": "geobrep.model.topology",
+    "Block": "geobrep.model.entities",
+    "BoundingBox": "geobrep.geometry",
+    "CRS": "geobrep.model.crs",
+    "ConversionSummary": "geobrep.batch.conversion",
+    "Corner": "geobrep.model.topology",
+    "Entity": "geobrep.model.entities",
+    "FileReport": "geobrep.batch.conversion",
+    "FitReport": "geobrep.ops.fitting",
+    "FitResult": "geobrep.ops.fitting",
+    "Group": "geobrep.model.scene",
+    "LinearOctree": "geobrep.model.entities",
+    "NurbsSurface": "geobrep.model.entities",
+    "Patch": "geobrep.model.topology",
+    "PatchSide": "geobrep.model.entities",
     "Pipeline": "geobrep.batch.pipeline",
     "PipelineSummary": "geobrep.batch.pipeline_run",
+    "Plane": "geobrep.geometry",
+    "PointSet": "geobrep.model.entities",
+    "PolyLine": "geobrep.model.entities",
+    "Polygon": "geobrep.model.entities",
+    "Property": "geobrep.model.properties",
+    "Scene": "geobrep.model.scene",
+    "Surface": "geobrep.model.entities",
+    "TetMesh": "geobrep.model.entities",
+    "Topology": "geobrep.model.topology",
+    "VoxelizationWarning": "geobrep.ops.voxelization",
+    "build_blocks": "geobrep.ops.building",
+    "clip": "geobrep.ops.clipping",
+    "clip_box": "geobrep.ops.clipping",
+    "convert": "geobrep.batch.conversion",
+    "fit": "geobrep.ops.fitting",
+    "from_geodataframe": "geobrep.gis.crs_ops",
+    "map_products": "geobrep.gis.map_products",
+    "read": "geobrep.ops.io",
     "run_pipeline": "geobrep.batch.pipeline_run",
+    "section": "geobrep.ops.clipping",
+    "to_geodataframe": "geobrep.gis.crs_ops",
+    "voxelize": "geobrep.ops.voxelization",
+    "write": "geobrep.ops.io",
 }
 
 

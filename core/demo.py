@@ -121,7 +121,7 @@ def _native_stage(ctx: DemoContext) -> None:
 
 def _gocad_stage(ctx: DemoContext) -> None:
     """The model through GOCAD Model3d and TSurf files (the ``gocad`` format plugin)."""
-    from geobrep.plugins import registries
+    from geobrep.host import registries
 
     if "gocad" not in registries().formats:
         ctx.summary["gocad"] = {"status": "skipped", "reason": "format 'gocad' not installed"}

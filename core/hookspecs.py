@@ -27,6 +27,7 @@ if TYPE_CHECKING:
         ClipperRegistry,
         FitterRegistry,
         FormatRegistry,
+        VoxelizerRegistry,
     )
 
 __all__ = ["PROJECT_NAME", "GeobrepSpecs", "hookimpl", "hookspec"]
@@ -73,7 +74,7 @@ class GeobrepSpecs:
 
     @hookspec
     def geobrep_register_fitters(self, registry: FitterRegistry) -> None:
-        """Register surface or curve fitters: :class:`~geobrep.host.registry.FitterSpec` items.
+        """Register surface or curve fitters: :class:`~geobrep.plugins.FitterSpec` items.
 
         Example::
 
@@ -86,7 +87,7 @@ class GeobrepSpecs:
 
     @hookspec
     def geobrep_register_builders(self, registry: BuilderRegistry) -> None:
-        """Register topology or block builders: :class:`~geobrep.host.registry.BuilderSpec` items.
+        """Register topology or block builders: :class:`~geobrep.plugins.BuilderSpec` items.
 
         Example::
 
@@ -94,5 +95,19 @@ class GeobrepSpecs:
             def geobrep_register_builders(registry):
                 registry.add(BuilderSpec(
                     name="blocks", function=build_blocks, input_types=("Surface",),
+                ))
+        """
+
+    @hookspec
+    def geobrep_register_voxelizers(self, registry: VoxelizerRegistry) -> None:
+        """Register voxelizers: :class:`~geobrep.plugins.VoxelizerSpec` items, each turning the
+        closed bodies of a scene into a :class:`~geobrep.LinearOctree`.
+
+        Example::
+
+            @hookimpl
+            def geobrep_register_voxelizers(registry):
+                registry.add(VoxelizerSpec(
+                    name="octree", function=voxelize_scene, options=VoxelizeOptions,
                 ))
         """

@@ -1,4 +1,4 @@
-"""Built-in geobrep plugins, and the facade plugin authors import from.
+"""Built-in geobrep plugins, and the one surface plugin authors import from.
 
 A plugin is a module (or object) with ``@hookimpl`` functions, declared as an entry point
 in the ``geobrep.plugins`` group of its distribution's ``pyproject.toml``::
@@ -14,12 +14,18 @@ and implementing any of the hooks of :mod:`geobrep.hookspecs`::
     def geobrep_register_formats(registry):
         registry.add(FormatSpec(name="xyz", extensions=(".xyz",), reader=read_xyz))
 
+Everything a plugin needs is importable from here: the :data:`hookimpl` marker, the spec and
+registry types (``FormatSpec``, ``ClipperSpec``, ``FitterSpec``, ``BuilderSpec``,
+``VoxelizerSpec``, ...), the clipping context (``ClipContext``, ``SceneDraft``, ``halves``,
+``pack_halves``), the fit result types (``FitResult``, ``FitReport``), ``atomic_write``, the
+topology helpers (``chain_arc_edges``, ``build_corners_and_arcs``) and the errors. The model
+itself (``Scene``, ``Surface``, ``Plane``, ...) comes from :mod:`geobrep`, the kernels from
+:mod:`geobrep.geometry`. The built-in plugins below use only these three.
+
 The entry-point name (``example``) is the plugin's name in ``geobrep plugins`` and in
 ``GEOBREP_DISABLE_PLUGINS``. Built-in plugins are entry points of geobrep itself and load
-first. See ``docs/plugin-guide.md``.
-
-Importing this package is cheap (pluggy only); the registry types and the loader are
-imported on first use.
+first. See ``docs/plugin-guide.md``. Importing this package is cheap (pluggy only: no numpy,
+no entity models); every other name is imported on first use.
 """
 
 from __future__ import annotations
@@ -28,41 +34,161 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 from geobrep.hookspecs import hookimpl
+from geobrep.host import list_plugins, register, registries, reload
 
 if TYPE_CHECKING:
-    from geobrep.host.loader import PluginInfo
+    from geobrep.errors import (
+        DegenerateGeometryError,
+        EntityNotFoundError,
+        EntityValidationError,
+        FileAccessError,
+        FormatError,
+        GeobrepError,
+        MissingDependencyError,
+        OptionsError,
+        PluginError,
+        TopologyError,
+        UnknownFormatError,
+    )
+    from geobrep.host.loader import (
+        PluginInfo,
+    )
     from geobrep.host.registry import (
+        SNIFF_BYTES,
+        BuilderRegistry,
         BuilderSpec,
+        ClipperRegistry,
         ClipperSpec,
+        FitterRegistry,
         FitterSpec,
         FormatCapabilities,
+        FormatRegistry,
         FormatSpec,
+        NoOptions,
         Registries,
+        VoxelizerRegistry,
+        VoxelizerSpec,
+    )
+    from geobrep.model.arcs import (
+        ArcChains,
+        build_corners_and_arcs,
+        chain_arc_edges,
+    )
+    from geobrep.model.entities import (
+        UNIVERSE_KIND,
+    )
+    from geobrep.model.properties import (
+        PropertyMap,
+    )
+    from geobrep.ops.clipping import (
+        ClipContext,
+        Keep,
+        SceneDraft,
+        halves,
+        pack_halves,
+    )
+    from geobrep.ops.fitting import (
+        Deviation,
+        FitReport,
+        FitResult,
+        SubsetReport,
+    )
+    from geobrep.ops.io import (
+        atomic_write,
     )
 
 __all__ = [
+    "SNIFF_BYTES",
+    "UNIVERSE_KIND",
+    "ArcChains",
+    "BuilderRegistry",
     "BuilderSpec",
+    "ClipContext",
+    "ClipperRegistry",
     "ClipperSpec",
+    "DegenerateGeometryError",
+    "Deviation",
+    "EntityNotFoundError",
+    "EntityValidationError",
+    "FileAccessError",
+    "FitReport",
+    "FitResult",
+    "FitterRegistry",
     "FitterSpec",
     "FormatCapabilities",
+    "FormatError",
+    "FormatRegistry",
     "FormatSpec",
+    "GeobrepError",
+    "Keep",
+    "MissingDependencyError",
+    "NoOptions",
+    "OptionsError",
+    "PluginError",
     "PluginInfo",
+    "PropertyMap",
     "Registries",
+    "SceneDraft",
+    "SubsetReport",
+    "TopologyError",
+    "UnknownFormatError",
+    "VoxelizerRegistry",
+    "VoxelizerSpec",
+    "atomic_write",
+    "build_corners_and_arcs",
+    "chain_arc_edges",
+    "halves",
     "hookimpl",
     "list_plugins",
+    "pack_halves",
     "register",
     "registries",
     "reload",
 ]
 
+#: Where each lazily imported name lives.
 _LAZY = {
+    "PluginInfo": "geobrep.host.loader",
+    "SNIFF_BYTES": "geobrep.host.registry",
+    "BuilderRegistry": "geobrep.host.registry",
     "BuilderSpec": "geobrep.host.registry",
+    "ClipperRegistry": "geobrep.host.registry",
     "ClipperSpec": "geobrep.host.registry",
+    "FitterRegistry": "geobrep.host.registry",
     "FitterSpec": "geobrep.host.registry",
     "FormatCapabilities": "geobrep.host.registry",
+    "FormatRegistry": "geobrep.host.registry",
     "FormatSpec": "geobrep.host.registry",
+    "NoOptions": "geobrep.host.registry",
     "Registries": "geobrep.host.registry",
-    "PluginInfo": "geobrep.host.loader",
+    "VoxelizerRegistry": "geobrep.host.registry",
+    "VoxelizerSpec": "geobrep.host.registry",
+    "ClipContext": "geobrep.ops.clipping",
+    "Keep": "geobrep.ops.clipping",
+    "SceneDraft": "geobrep.ops.clipping",
+    "halves": "geobrep.ops.clipping",
+    "pack_halves": "geobrep.ops.clipping",
+    "Deviation": "geobrep.ops.fitting",
+    "FitReport": "geobrep.ops.fitting",
+    "FitResult": "geobrep.ops.fitting",
+    "SubsetReport": "geobrep.ops.fitting",
+    "atomic_write": "geobrep.ops.io",
+    "ArcChains": "geobrep.model.arcs",
+    "build_corners_and_arcs": "geobrep.model.arcs",
+    "chain_arc_edges": "geobrep.model.arcs",
+    "UNIVERSE_KIND": "geobrep.model.entities",
+    "PropertyMap": "geobrep.model.properties",
+    "DegenerateGeometryError": "geobrep.errors",
+    "EntityNotFoundError": "geobrep.errors",
+    "EntityValidationError": "geobrep.errors",
+    "FileAccessError": "geobrep.errors",
+    "FormatError": "geobrep.errors",
+    "GeobrepError": "geobrep.errors",
+    "MissingDependencyError": "geobrep.errors",
+    "OptionsError": "geobrep.errors",
+    "PluginError": "geobrep.errors",
+    "TopologyError": "geobrep.errors",
+    "UnknownFormatError": "geobrep.errors",
 }
 
 
@@ -77,58 +203,3 @@ def __getattr__(name: str) -> Any:
 
 def __dir__() -> list[str]:
     return sorted(set(globals()) | set(__all__))
-
-
-def list_plugins() -> list[PluginInfo]:
-    """Every discovered plugin with its status, distribution and registered items.
-
-    Example:
-        >>> [(p.name, p.status) for p in list_plugins()]  # doctest: +SKIP
-        [('native', 'loaded'), ('example', 'loaded')]
-    """
-    from geobrep.host.loader import get_host
-
-    return get_host().plugins
-
-
-def registries() -> Registries:
-    """The registries filled by all loaded plugins (discovering them on first use).
-
-    Example:
-        >>> registries().formats.choose_reader("points.xyz").name  # doctest: +SKIP
-        'xyz'
-    """
-    from geobrep.host.loader import get_host
-
-    return get_host().registries
-
-
-def register(plugin: object, name: str) -> PluginInfo:
-    """Register an in-process plugin (a module or object with ``@hookimpl`` functions).
-
-    It is isolated like an installed plugin: a failure warns and returns status ``"failed"``.
-    First registration of a name wins, so installed plugins keep theirs.
-
-    Example:
-        >>> class MyPlugin:
-        ...     @hookimpl
-        ...     def geobrep_register_fitters(self, registry):
-        ...         registry.add(FitterSpec(name="mine", function=lambda entities, options: None))
-        >>> register(MyPlugin(), "my-plugin").registered["fitters"]  # doctest: +SKIP
-        ('mine',)
-    """
-    from geobrep.host.loader import register_plugin
-
-    return register_plugin(plugin, name)
-
-
-def reload() -> None:
-    """Forget every plugin (in-process ones too) and rediscover the installed ones.
-
-    Example:
-        >>> reload()  # doctest: +SKIP
-    """
-    from geobrep.host.loader import get_host, reset
-
-    reset()
-    get_host()

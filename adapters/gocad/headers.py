@@ -8,6 +8,7 @@ from typing import Any
 
 from geobrep.adapters.gocad.lexer import split_tokens
 from geobrep.adapters.gocad.numbers import parse_float
+from geobrep.adapters.gocad.records import Warn
 
 __all__ = [
     "PROPERTY_KEYWORDS",
@@ -122,7 +123,7 @@ class PropertyHeader:
     def n_values(self) -> int:
         return sum(spec.esize for spec in self.specs)
 
-    def resolve(self, warn: Any) -> None:
+    def resolve(self, warn: Warn) -> None:
         """Apply the collected lines: the names first (``PROPERTIES``, or ``PROPERTY_CLASSES``
         when there is no ``PROPERTIES`` line), then every other line in file order."""
         if self.resolved:
@@ -156,7 +157,7 @@ _LAYOUT_KEYWORDS = ("PROPERTIES", "ESIZES")
 
 
 def parse_property_line(
-    header: PropertyHeader, keyword: str, text: str, line: int, warn: Any
+    header: PropertyHeader, keyword: str, text: str, line: int, warn: Warn
 ) -> None:
     """One property-header line (``keyword`` without its TRGL_/SEG_/TETRA_ prefix): collected
     until :meth:`PropertyHeader.resolve`, applied at once after it."""
@@ -171,61 +172,68 @@ def parse_property_line(
         _apply(header, keyword, text, line, warn)
 
 
-def _name_properties(header: PropertyHeader, text: str, line: int, warn: Any) -> None:
+def _name_properties(header: PropertyHeader, text: str, line: int, warn: Warn) -> None:
     tokens = split_tokens(text)[1:]
     if header.specs:
         warn(f"a second PROPERTIES line replaces the first (line {line})", line)
     header.specs = [PropertySpec(name=name or f"property_{i}") for i, name in enumerate(tokens)]
 
 
-def _apply(header: PropertyHeader, keyword: str, text: str, line: int, warn: Any) -> None:
+def _apply(header: PropertyHeader, keyword: str, text: str, line: int, warn: Warn) -> None:
     tokens = split_tokens(text)[1:]
     specs = header.specs
     if not specs:
         warn(f"{keyword} without PROPERTIES is ignored", line)
         return
-    groups: list[Any]
+    groups: list[list[str]] = []
     if keyword == "PROP_LEGAL_RANGES":
         groups = [tokens[i : i + 2] for i in range(0, len(tokens), 2)]
     elif keyword == "PROPERTY_SUBCLASSES":
         groups = _subclasses(tokens)
-    else:
-        groups = tokens
-    if len(groups) != len(specs):
+    count = len(groups) if groups else len(tokens)
+    if count != len(specs):
         warn(
-            f"{keyword} gives {len(groups)} entries for {len(specs)} properties; "
+            f"{keyword} gives {count} entries for {len(specs)} properties; "
             "extra entries are ignored, missing ones keep their defaults",
             line,
         )
-    for spec, value in zip(specs, groups, strict=False):
-        if keyword == "ESIZES":
-            try:
-                size = int(value)
-            except ValueError:
-                warn(f"ESIZES entry {value!r} is not an integer; using 1", line)
-                size = 1
-            if size < 1:
-                warn(f"ESIZES entry {size} is not positive; using 1", line)
-                size = 1
-            spec.esize = size
-        elif keyword == "NO_DATA_VALUES":
-            try:
-                spec.no_data = parse_float(value)
-            except ValueError:
-                warn(f"no-data value {value!r} is not a number; ignored", line)
-        elif keyword == "PROP_LEGAL_RANGES":
-            if len(value) == 2:
-                spec.legal_range = (value[0], value[1])
-        elif keyword == "PROPERTY_CLASSES":
-            spec.klass = value
-        elif keyword == "PROPERTY_KINDS":
-            spec.kind = value
-        elif keyword == "PROPERTY_SUBCLASSES":
-            spec.subclass = list(value)
-        elif keyword == "UNITS":
-            spec.unit = None if value.lower() == "none" else value
-        elif keyword == "READ_ONLY":
-            spec.read_only = value
+    if keyword == "PROP_LEGAL_RANGES":
+        for spec, pair in zip(specs, groups, strict=False):
+            if len(pair) == 2:
+                spec.legal_range = (pair[0], pair[1])
+    elif keyword == "PROPERTY_SUBCLASSES":
+        for spec, group in zip(specs, groups, strict=False):
+            spec.subclass = list(group)
+    else:
+        for spec, value in zip(specs, tokens, strict=False):
+            _apply_entry(spec, keyword, value, line, warn)
+
+
+def _apply_entry(spec: PropertySpec, keyword: str, value: str, line: int, warn: Warn) -> None:
+    """One entry of a one-token-per-property keyword (ESIZES, NO_DATA_VALUES, UNITS, ...)."""
+    if keyword == "ESIZES":
+        try:
+            size = int(value)
+        except ValueError:
+            warn(f"ESIZES entry {value!r} is not an integer; using 1", line)
+            size = 1
+        if size < 1:
+            warn(f"ESIZES entry {size} is not positive; using 1", line)
+            size = 1
+        spec.esize = size
+    elif keyword == "NO_DATA_VALUES":
+        try:
+            spec.no_data = parse_float(value)
+        except ValueError:
+            warn(f"no-data value {value!r} is not a number; ignored", line)
+    elif keyword == "PROPERTY_CLASSES":
+        spec.klass = value
+    elif keyword == "PROPERTY_KINDS":
+        spec.kind = value
+    elif keyword == "UNITS":
+        spec.unit = None if value.lower() == "none" else value
+    elif keyword == "READ_ONLY":
+        spec.read_only = value
 
 
 def quote_rest(text: str) -> str:

@@ -12,21 +12,25 @@
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.gocad.objects import gocad_section
+from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.adapters.gocad.parser import GocadObject
+from geobrep.adapters.gocad.records import Diagnostics, Model3dHeader, ModelList, TFaceEntry
 from geobrep.geometry.bbox import column_extremes
 from geobrep.model.arcs import corners_and_arcs
 from geobrep.model.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
 from geobrep.model.orientation import orient_patches
 from geobrep.model.scene import Group
-from geobrep.model.topology import Patch, Topology
+from geobrep.model.topology import Corner, Patch, Topology
 
-__all__ = ["attach_model3d", "border_topology", "find_key_triangle"]
+__all__ = ["Model3dParts", "attach_model3d", "border_topology", "find_key_triangle"]
 
 _LIST_KINDS = {
     "LAYER": "layer",
@@ -36,6 +40,16 @@ _LIST_KINDS = {
     "BOUNDARY": "boundary",
     "UNIT": "unit",
 }
+
+
+class Model3dParts(NamedTuple):
+    """What a Model3d header adds to a scene."""
+
+    topology: Topology
+    blocks: list[Entity]
+    groups: list[Group]
+    metadata: dict[str, Any]  # the scene's metadata["gocad"]["model3d"]
+    surfaces: list[Surface]  # the member surfaces (turned to agree with their key triangles)
 
 
 def find_key_triangle(
@@ -74,183 +88,230 @@ def attach_model3d(
     surfaces: list[Surface],
     first_id: int,
     z_sign: float,
-    options: Any,
-    builder: Any,
-) -> tuple[Topology, list[Entity], list[Group], dict[str, Any], list[Surface]]:
+    options: GocadOptions,
+    builder: Diagnostics,
+) -> Model3dParts:
     """Topology, blocks, groups, scene metadata and the member surfaces of a Model3d header.
 
     With ``options.repair`` (the default) each TFACE's triangles are turned to agree with its
     key triangle, so the surfaces returned may differ from those given.
     """
-    by_name: dict[str, Surface] = {}
-    listed: set[str] = set()  # names given by name_in_model_list
-    for surface in surfaces:
-        names = _tsurf_names(surface)
-        if len(names) > 1:
-            listed.add(names[0])
-        for name in names:
-            by_name.setdefault(name, surface)
+    header = model.model3d
+    diagonal = _diagonal(surfaces)
+    matched = _TFaceMatcher(surfaces, z_sign, 1e-9 * max(diagonal, 1.0), builder)
+    matched.match_all(header)
+    if options.repair:
+        surfaces = _orient_by_key_triangles(surfaces, matched.key_faces, matched.patches, builder)
+    blocks, region_block = _region_blocks(header, matched, first_id, builder)
+    patches = _with_blocks(matched.patches, blocks)
+    groups = _groups(header.lists, region_block, patches, builder)
+    topology = _rebuilt_topology(
+        surfaces, patches, options.merge_tolerance_for(diagonal), builder.warn
+    )
+    return Model3dParts(topology, blocks, groups, _model_metadata(model), surfaces)
+
+
+def _diagonal(surfaces: Sequence[Surface]) -> float:
+    """The bounding-box diagonal of the surfaces' vertices (1 when they have none)."""
     points = [s.vertices for s in surfaces if s.n_vertices]
-    if points:
-        stacked = np.concatenate(points)
-        low, high = column_extremes(stacked)
-        diagonal = float(np.linalg.norm(high - low))
-    else:
-        diagonal = 1.0
-    key_tolerance = 1e-9 * max(diagonal, 1.0)
-    patches: list[Patch] = []
-    flipped: dict[int, bool] = {}
-    seen_parts: dict[str, int] = {}
-    key_faces: dict[int, dict[int, int | None]] = {}  # surface id -> patch label -> key face
-    declared = set(model.model.get("tsurfs", []))
-    for entry in model.model.get("tfaces", []):
-        if entry["tsurf"] not in declared:
+    if not points:
+        return 1.0
+    low, high = column_extremes(np.concatenate(points))
+    return float(np.linalg.norm(high - low))
+
+
+@dataclass
+class _TFaceMatcher:
+    """Header TFACEs matched to the TFACE parts of the member TSurfs, one patch each."""
+
+    surfaces: list[Surface]
+    z_sign: float
+    key_tolerance: float
+    builder: Diagnostics
+    patches: list[Patch] = field(default_factory=list)
+    flipped: dict[int, bool] = field(default_factory=dict)  # TFACE id -> key triangle reversed
+    key_faces: dict[int, dict[int, int | None]] = field(default_factory=dict)
+    """surface id -> patch label -> face index of its key triangle (None: not found)."""
+
+    def match_all(self, header: Model3dHeader) -> None:
+        by_name: dict[str, Surface] = {}
+        listed: set[str] = set()  # names given by name_in_model_list
+        for surface in self.surfaces:
+            names = _tsurf_names(surface)
+            if len(names) > 1:
+                listed.add(names[0])
+            for name in names:
+                by_name.setdefault(name, surface)
+        declared = set(header.tsurfs)
+        seen_parts: dict[str, int] = {}
+        for entry in header.tfaces:
+            surface = self._surface_of(entry, by_name, listed, declared)
+            label = seen_parts.get(entry.tsurf, 0)
+            seen_parts[entry.tsurf] = label + 1
+            self._match(entry, surface, label)
+
+    def _surface_of(
+        self, entry: TFaceEntry, by_name: dict[str, Surface], listed: set[str], declared: set[str]
+    ) -> Surface:
+        """The TSurf a header TFACE names (warnings when the header does not declare it well)."""
+        builder = self.builder
+        if entry.tsurf not in declared:
             builder.warn(
-                f"TFACE {entry['id']} names {entry['tsurf']!r}, which has no TSURF line",
-                entry["line"],
+                f"TFACE {entry.id} names {entry.tsurf!r}, which has no TSURF line", entry.line
             )
-            declared.add(entry["tsurf"])
-        found = by_name.get(entry["tsurf"])
+            declared.add(entry.tsurf)
+        found = by_name.get(entry.tsurf)
         if found is None:
             raise builder.error(
-                f"TFACE {entry['id']} names TSurf {entry['tsurf']!r}, which is not in the file",
-                entry["line"],
+                f"TFACE {entry.id} names TSurf {entry.tsurf!r}, which is not in the file",
+                entry.line,
             )
-        surface = found
-        if entry["tsurf"] not in listed:
+        if entry.tsurf not in listed:
             builder.warn(
-                f"TSurf {entry['tsurf']!r} has no name_in_model_list: matched by its name",
-                entry["line"],
+                f"TSurf {entry.tsurf!r} has no name_in_model_list: matched by its name", entry.line
             )
-            listed.add(entry["tsurf"])
-        label = seen_parts.get(entry["tsurf"], 0)
-        seen_parts[entry["tsurf"]] = label + 1
+            listed.add(entry.tsurf)
+        return found
+
+    def _match(self, entry: TFaceEntry, surface: Surface, label: int) -> None:
+        """The patch of TFACE ``entry``: part ``label`` of ``surface``, its key triangle found."""
         if label >= surface.n_patches:
-            raise builder.error(
-                f"TFACE {entry['id']} is part {label + 1} of TSurf {entry['tsurf']!r}, "
+            raise self.builder.error(
+                f"TFACE {entry.id} is part {label + 1} of TSurf {entry.tsurf!r}, "
                 f"which has {surface.n_patches} TFACE part(s)",
-                entry["line"],
+                entry.line,
             )
-        key = np.asarray(entry["key"], dtype=np.float64)
-        key[:, 2] *= z_sign
-        face, reverse = find_key_triangle(surface, label, key, key_tolerance)
+        key = np.asarray(entry.key, dtype=np.float64)
+        key[:, 2] *= self.z_sign
+        face, reverse = find_key_triangle(surface, label, key, self.key_tolerance)
         if face is None:
-            builder.warn(
-                f"the key triangle of TFACE {entry['id']} is not a triangle of part {label + 1} "
-                f"of {entry['tsurf']!r}; its REGION signs are taken as they are",
-                entry["line"],
+            self.builder.warn(
+                f"the key triangle of TFACE {entry.id} is not a triangle of part {label + 1} "
+                f"of {entry.tsurf!r}; its REGION signs are taken as they are",
+                entry.line,
             )
-        flipped[entry["id"]] = reverse
-        key_faces.setdefault(int(surface.id or 0), {})[label] = face
-        gocad: dict[str, Any] = {"geological_type": entry["type"], "key_triangle": face}
+        self.flipped[entry.id] = reverse
+        self.key_faces.setdefault(int(surface.id or 0), {})[label] = face
+        gocad: dict[str, Any] = {"geological_type": entry.type, "key_triangle": face}
         if reverse:
             gocad["key_reversed"] = True
-        patches.append(
+        self.patches.append(
             Patch(
-                id=entry["id"],
+                id=entry.id,
                 surface=int(surface.id or 0),
                 label=label,
-                name=f"{entry['tsurf']}:{label}",
+                name=f"{entry.tsurf}:{label}",
                 metadata={"gocad": gocad},
             )
         )
-    if getattr(options, "repair", True):
-        surfaces = _orient_by_key_triangles(surfaces, key_faces, patches, builder)
-    patch_ids = {p.id for p in patches}
+
+
+def _region_blocks(
+    header: Model3dHeader, matched: _TFaceMatcher, first_id: int, builder: Diagnostics
+) -> tuple[list[Entity], dict[int, int]]:
+    """One block per REGION (sides as the key triangles say) and ``{REGION id: block id}``."""
+    patch_ids = {p.id for p in matched.patches}
+    layer_of: dict[int, str] = {}
+    for entry in header.lists:
+        if entry.keyword == "LAYER":
+            for region_id in entry.items:
+                layer_of.setdefault(region_id, entry.name)
+    n_tfaces = len(matched.patches)
     blocks: list[Entity] = []
     region_block: dict[int, int] = {}
-    lists = model.model.get("lists", [])
-    layer_of: dict[int, str] = {}
-    for keyword, entry in lists:
-        if keyword == "LAYER":
-            for region in entry["items"]:
-                layer_of.setdefault(region, entry["name"])
-    n_tfaces = len(patches)
-    for keyword, entry in lists:
-        if keyword != "REGION":
-            continue
-        if entry["id"] <= n_tfaces or entry["id"] in region_block:
+    for region in header.regions:
+        if region.id <= n_tfaces or region.id in region_block:
             builder.warn(
-                f"REGION id {entry['id']} should follow the TFACE ids and be unique; "
+                f"REGION id {region.id} should follow the TFACE ids and be unique; "
                 "it is renumbered when written",
-                entry["line"],
+                region.line,
             )
         sides: list[PatchSide] = []
-        for value in entry["items"]:
+        for value in region.items:
             tface = abs(value)
             if tface not in patch_ids:
                 raise builder.error(
-                    f"REGION {entry['name']!r} refers to TFACE {tface}, which is not defined",
-                    entry["line"],
+                    f"REGION {region.name!r} refers to TFACE {tface}, which is not defined",
+                    region.line,
                 )
             side = 1 if value > 0 else -1
-            if flipped.get(tface):
+            if matched.flipped.get(tface):
                 side = -side
             pair = PatchSide(tface, side)  # type: ignore[arg-type]
             if pair in sides:
-                builder.warn(f"REGION {entry['name']!r} lists {value:+d} twice", entry["line"])
+                builder.warn(f"REGION {region.name!r} lists {value:+d} twice", region.line)
                 continue
             sides.append(pair)
         block_id = first_id + len(blocks)
-        region_block[entry["id"]] = block_id
-        universe = entry["name"].strip().lower() == "universe"
+        region_block[region.id] = block_id
+        universe = region.name.strip().lower() == "universe"
         blocks.append(
             Block(
                 id=block_id,
-                name=entry["name"],
+                name=region.name,
                 kind=UNIVERSE_KIND if universe else "unit",
                 sides=tuple(sides),
-                unit_name=None if universe else layer_of.get(entry["id"]),
-                metadata={"gocad": {"region_id": entry["id"]}},
+                unit_name=None if universe else layer_of.get(region.id),
+                metadata={"gocad": {"region_id": region.id}},
             )
         )
+    return blocks, region_block
+
+
+def _with_blocks(patches: list[Patch], blocks: list[Entity]) -> list[Patch]:
+    """The patches with the first block on each of their sides."""
     positive: dict[int, int] = {}
     negative: dict[int, int] = {}
     for block in blocks:
         assert isinstance(block, Block)
         for patch_id, side in block.sides:
             (positive if side == 1 else negative).setdefault(patch_id, int(block.id or 0))
-    patches = [
+    return [
         p.model_copy(
             update={"positive_block": positive.get(p.id), "negative_block": negative.get(p.id)}
         )
         for p in patches
     ]
-    groups = _groups(lists, region_block, patches, builder)
-    bstones = _bstone_points(surfaces)
+
+
+def _rebuilt_topology(
+    surfaces: list[Surface],
+    patches: list[Patch],
+    tolerance: float,
+    warn: Callable[[str], None] | None,
+) -> Topology:
+    """Corners and arcs rebuilt from the patches (BSTONEs as extra corners) around them."""
     corners, arcs, patch_arcs = corners_and_arcs(
-        {int(s.id or 0): s for s in surfaces},
-        patches,
-        options.merge_tolerance_for(diagonal),
-        bstones,
+        {int(s.id or 0): s for s in surfaces}, patches, tolerance, _bstone_points(surfaces)
     )
-    warn_idle_bstones(surfaces, corners, options.merge_tolerance_for(diagonal), builder.warn)
-    topology = Topology(
+    if warn is not None:
+        warn_idle_bstones(surfaces, corners, tolerance, warn)
+    return Topology(
         corners=tuple(corners),
         arcs=tuple(arcs),
         patches=tuple(
             p.model_copy(update={"arcs": tuple(patch_arcs.get(p.id, ()))}) for p in patches
         ),
     )
-    metadata: dict[str, Any] = {
-        "gocad": {
-            "model3d": {
-                "version": model.version,
-                "header": [[k, v] for k, v in model.header],
-                "tsurfs": model.model.get("tsurfs", []),
-            }
-        }
+
+
+def _model_metadata(model: GocadObject) -> dict[str, Any]:
+    """What the scene keeps of the Model3d object (JSON, for the writer)."""
+    kept: dict[str, Any] = {
+        "version": model.version,
+        "header": [[k, v] for k, v in model.header],
+        "tsurfs": list(model.model3d.tsurfs),
     }
     if model.extra_lines:
-        metadata["gocad"]["model3d"]["extra_lines"] = model.extra_lines
-    return topology, blocks, groups, metadata, surfaces
+        kept["extra_lines"] = model.extra_lines
+    return {"gocad": {"model3d": kept}}
 
 
 def _orient_by_key_triangles(
     surfaces: list[Surface],
     key_faces: dict[int, dict[int, int | None]],
     patches: list[Patch],
-    builder: Any,
+    builder: Diagnostics,
 ) -> list[Surface]:
     """Each TFACE's triangles turned to agree with its key triangle (one warning per surface)."""
     tface_of = {(p.surface, p.label): p.id for p in patches}
@@ -273,36 +334,34 @@ def _orient_by_key_triangles(
 
 
 def _groups(
-    lists: list[tuple[str, dict[str, Any]]],
+    lists: Sequence[ModelList],
     region_block: dict[int, int],
     patches: list[Patch],
-    builder: Any,
+    builder: Diagnostics,
 ) -> list[Group]:
     surface_of_tface = {p.id: p.surface for p in patches}
     groups: list[Group] = []
-    for keyword, entry in lists:
-        if keyword == "REGION":
-            continue
-        items = entry["items"]
-        if keyword in ("LAYER", "FAULT_BLOCK"):
+    for entry in lists:
+        items = list(entry.items)
+        if entry.keyword in ("LAYER", "FAULT_BLOCK"):
             unknown = [i for i in items if i not in region_block]
             if unknown:
                 builder.warn(
-                    f"{keyword} {entry['name']!r}: id {unknown[0]} does not match a REGION",
-                    entry["line"],
+                    f"{entry.keyword} {entry.name!r}: id {unknown[0]} does not match a REGION",
+                    entry.line,
                 )
             members = [region_block[i] for i in items if i in region_block]
             # "unmatched": ids the file itself lists without a REGION (kept when written)
-            raw = {"keyword": keyword, "regions": items, "unmatched": unknown}
+            raw = {"keyword": entry.keyword, "regions": items, "unmatched": unknown}
         else:
             members = list(
                 dict.fromkeys(surface_of_tface[i] for i in items if i in surface_of_tface)
             )
-            raw = {"keyword": keyword, "tfaces": items}
+            raw = {"keyword": entry.keyword, "tfaces": items}
         groups.append(
             Group(
-                name=entry["name"],
-                kind=_LIST_KINDS[keyword],
+                name=entry.name,
+                kind=_LIST_KINDS[entry.keyword],
                 members=tuple(dict.fromkeys(members)),
                 metadata={"gocad": raw},
             )
@@ -320,7 +379,10 @@ def _bstone_points(surfaces: list[Surface]) -> NDArray[np.float64]:
 
 
 def warn_idle_bstones(
-    surfaces: list[Surface], corners: list[Any], tolerance: float, warn: Any
+    surfaces: list[Surface],
+    corners: Sequence[Corner],
+    tolerance: float,
+    warn: Callable[[str], None],
 ) -> None:
     """One warning per surface whose BSTONEs mark no corner (not on a border of the model):
     a writer then puts its BSTONEs at the corners, so they need not come back as they were."""
@@ -345,29 +407,19 @@ def warn_idle_bstones(
             )
 
 
-def border_topology(surfaces: list[Surface], options: Any, warn: Any | None = None) -> Topology:
+def border_topology(
+    surfaces: list[Surface],
+    options: GocadOptions,
+    warn: Callable[[str], None] | None = None,
+) -> Topology:
     """Patches (one per TFACE) with corners from BSTONEs and arcs, for TSurfs outside a Model3d."""
     patches = [
-        Patch(id=len_ + 0, surface=int(s.id or 0), label=label, name=f"{s.name}:{label}")
-        for len_, (s, label) in enumerate(
+        Patch(id=number, surface=int(s.id or 0), label=label, name=f"{s.name}:{label}")
+        for number, (s, label) in enumerate(
             (s, label) for s in surfaces for label in range(s.n_patches)
         )
     ]
     points = np.concatenate([s.vertices for s in surfaces if s.n_vertices] or [np.zeros((1, 3))])
     low, high = column_extremes(points)
     diagonal = float(np.linalg.norm(high - low))
-    corners, arcs, patch_arcs = corners_and_arcs(
-        {int(s.id or 0): s for s in surfaces},
-        patches,
-        options.merge_tolerance_for(diagonal),
-        _bstone_points(surfaces),
-    )
-    if warn is not None:
-        warn_idle_bstones(surfaces, corners, options.merge_tolerance_for(diagonal), warn)
-    return Topology(
-        corners=tuple(corners),
-        arcs=tuple(arcs),
-        patches=tuple(
-            p.model_copy(update={"arcs": tuple(patch_arcs.get(p.id, ()))}) for p in patches
-        ),
-    )
+    return _rebuilt_topology(surfaces, patches, options.merge_tolerance_for(diagonal), warn)

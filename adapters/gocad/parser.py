@@ -14,7 +14,6 @@ import re
 import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,6 +33,24 @@ from geobrep.adapters.gocad.lexer import (
     split_tokens,
 )
 from geobrep.adapters.gocad.numbers import parse_float, parse_int
+from geobrep.adapters.gocad.records import (
+    Border,
+    BStone,
+    CellRows,
+    CrsBlock,
+    CTetra,
+    Geology,
+    KeyVertices,
+    Model3dHeader,
+    ModelList,
+    ModelRegion,
+    RegionEntry,
+    SolidModel,
+    SolidSurface,
+    SolidTFace,
+    SolidTriangle,
+    TFaceEntry,
+)
 from geobrep.adapters.gocad.tables import CellTable, ResolvedVertices, VertexTable, check_finite_ids
 from geobrep.errors import FormatError
 
@@ -91,21 +108,26 @@ class GocadObject:
     version: str
     line: int
     header: list[tuple[str, str]] = field(default_factory=list)
-    crs: dict[str, Any] | None = None
-    geology: dict[str, Any] = field(default_factory=dict)
+    crs: CrsBlock | None = None
+    inherited_crs: bool = False  # crs is a group's, given to its member by the reader
+    geology: Geology = field(default_factory=dict)
     point_header: PropertyHeader = field(default_factory=PropertyHeader)
     cell_header: PropertyHeader = field(default_factory=PropertyHeader)
     class_headers: dict[str, dict[str, str]] = field(default_factory=dict)
     vertices: ResolvedVertices | None = None
-    cells: tuple[Any, ...] | None = None  # (ids, values, parts, lines) from CellTable.finish
+    cells: CellRows | None = None
     part_names: list[str] = field(default_factory=list)
     part_vertex_starts: list[int] = field(default_factory=list)
+    part_lines: list[int] = field(default_factory=list)  # where each part starts
     declared_parts: int = 0  # TFACE / ILINE / TVOLUME / SUBVSET lines (not implicit parts)
-    nonfinite: dict[tuple[str, int], list[int]] = field(default_factory=dict)  # -> [count, line]
-    bstones: list[tuple[int, int]] = field(default_factory=list)  # (vertex id, line)
-    borders: list[tuple[int, int, int, int]] = field(default_factory=list)  # (new, v0, v1, line)
-    ctetra: list[tuple[int, str, list[str], int]] = field(default_factory=list)
-    model: dict[str, Any] = field(default_factory=dict)  # Model3d header / TSolid MODEL
+    nonfinite: dict[tuple[str, int], tuple[int, int]] = field(default_factory=dict)
+    """(``"point"``/``"cell"``, property index) → (count, first line) of non-finite values."""
+    bstones: list[BStone] = field(default_factory=list)
+    borders: list[Border] = field(default_factory=list)
+    ctetra: list[CTetra] = field(default_factory=list)
+    model3d: Model3dHeader = field(default_factory=Model3dHeader)
+    solid_model: SolidModel = field(default_factory=SolidModel)
+    member_type: str | None = None  # a group's TYPE line
     members: list[GocadObject] = field(default_factory=list)
     extra_lines: list[str] = field(default_factory=list)
 
@@ -121,6 +143,81 @@ class GocadObject:
             if k == key:
                 return value
         return None
+
+
+@dataclass
+class _TFaceDraft:
+    id: int
+    type: str
+    tsurf: str
+    line: int
+    key: list[tuple[float, float, float]] = field(default_factory=list)
+
+
+@dataclass
+class _ListDraft:
+    keyword: str
+    name: str
+    line: int
+    region_id: int | None = None  # REGION only
+    items: list[int] = field(default_factory=list)
+    closed: bool = False  # the list's 0 was read
+
+
+@dataclass
+class _Model3dDraft:
+    """A Model3d header while its lines are read; :meth:`freeze` gives the record."""
+
+    tsurfs: list[str] = field(default_factory=list)
+    tfaces: list[_TFaceDraft] = field(default_factory=list)
+    lists: list[_ListDraft] = field(default_factory=list)
+    key_for: _TFaceDraft | None = None  # the TFACE whose key-triangle lines may follow
+    current: _ListDraft | None = None  # the list whose ids may follow
+
+    def freeze(self) -> Model3dHeader:
+        return Model3dHeader(
+            tsurfs=tuple(self.tsurfs),
+            tfaces=tuple(
+                TFaceEntry(t.id, t.type, t.tsurf, tuple(t.key), t.line) for t in self.tfaces
+            ),
+            regions=tuple(
+                RegionEntry(d.region_id, d.name, tuple(d.items), d.line)
+                for d in self.lists
+                if d.keyword == "REGION" and d.region_id is not None
+            ),
+            lists=tuple(
+                ModelList(d.keyword, d.name, tuple(d.items), d.line)
+                for d in self.lists
+                if d.keyword != "REGION"
+            ),
+        )
+
+
+@dataclass
+class _SolidTFaceDraft:
+    id: int
+    key: KeyVertices | None = None
+    triangles: list[SolidTriangle] = field(default_factory=list)
+
+
+@dataclass
+class _SolidDraft:
+    """A TSolid's MODEL section while its lines are read; :meth:`freeze` gives the record."""
+
+    in_model: bool = False
+    surfaces: list[tuple[str, list[_SolidTFaceDraft]]] = field(default_factory=list)
+    regions: list[ModelRegion] = field(default_factory=list)
+
+    def freeze(self) -> SolidModel:
+        return SolidModel(
+            surfaces=tuple(
+                SolidSurface(
+                    name, tuple(SolidTFace(t.id, t.key, tuple(t.triangles)) for t in tfaces)
+                )
+                for name, tfaces in self.surfaces
+            ),
+            regions=tuple(self.regions),
+        )
 
 
 class _Stream:
@@ -293,7 +390,7 @@ class _Parser:
         obj.class_headers[name] = entries
 
     def _crs_block(self, obj: GocadObject, line: Line) -> None:
-        crs: dict[str, Any] = {}
+        crs: CrsBlock = {}
         while True:
             item = self.stream.peek()
             if item is None or isinstance(item, Run):
@@ -361,7 +458,8 @@ class _Parser:
         vertices: VertexTable | None = None
         cells: CellTable | None = None
         part = -1
-        model_state: dict[str, Any] = {}
+        header = _Model3dDraft()
+        solid = _SolidDraft()
         while True:
             item = self.stream.peek()
             if item is None:
@@ -374,14 +472,14 @@ class _Parser:
             if isinstance(item, Run):
                 if vertices is None:
                     vertices, cells = self._tables(obj)
-                part = self._run(obj, item, vertices, cells, part)
+                part = self._run(obj, item, vertices, cells, part, solid)
                 continue
             keyword = _keyword(item.text)
             if keyword == "END":
                 break
             if obj.type == "Model3d":
                 if not self._common(obj, item):
-                    self._model3d_line(obj, item, model_state)
+                    self._model3d_line(obj, item, header)
                 continue
             if vertices is None:
                 # Header part: the property header is only complete at the first data line.
@@ -401,15 +499,16 @@ class _Parser:
             elif self._common(obj, item):
                 self.warn(f"{keyword} after the object's data lines", item.number)
                 continue
-            part = self._element_line(obj, item, keyword, vertices, cells, part, model_state)
+            part = self._element_line(obj, item, keyword, vertices, cells, part, solid)
         if obj.type == "Model3d":
-            self._finish_model3d(obj, model_state)
+            obj.model3d = self._finish_model3d(header)
             return
         if vertices is None:
             vertices, cells = self._tables(obj)
         self._report_nonfinite(obj)
         obj.vertices = vertices.finish(self.error)
-        obj.cells = cells.finish() if cells is not None else None
+        obj.cells = CellRows(*cells.finish()) if cells is not None else None
+        obj.solid_model = solid.freeze()
 
     def _tables(self, obj: GocadObject) -> tuple[VertexTable, CellTable | None]:
         """The vertex and cell tables, sized by the (now complete) property headers."""
@@ -419,9 +518,10 @@ class _Parser:
         cells = CellTable(width, obj.cell_header.n_values) if width else None
         return VertexTable(obj.point_header.n_values), cells
 
-    def _new_part(self, obj: GocadObject, name: str, vertices: VertexTable) -> int:
+    def _new_part(self, obj: GocadObject, name: str, vertices: VertexTable, line: int) -> int:
         obj.part_names.append(name)
         obj.part_vertex_starts.append(vertices.count)
+        obj.part_lines.append(line)
         return len(obj.part_names) - 1
 
     def _ensure_part(self, obj: GocadObject, part: int, vertices: VertexTable, line: int) -> int:
@@ -430,10 +530,16 @@ class _Parser:
         if obj.type in ("TSurf", "PLine"):
             missing = "TFACE" if obj.type == "TSurf" else "ILINE"
             self.warn(f"data before any {missing}: starting one", line)
-        return self._new_part(obj, "", vertices)
+        return self._new_part(obj, "", vertices, line)
 
     def _run(
-        self, obj: GocadObject, run: Run, vertices: VertexTable, cells: CellTable | None, part: int
+        self,
+        obj: GocadObject,
+        run: Run,
+        vertices: VertexTable,
+        cells: CellTable | None,
+        part: int,
+        solid: _SolidDraft,
     ) -> int:
         if run.keyword in ("VRTX", "PVRTX"):
             part = self._ensure_part(obj, part, vertices, run.first)
@@ -445,7 +551,7 @@ class _Parser:
                 if block.shape[1] != width:
                     raise BulkParseError
             except BulkParseError:
-                self._run_lines(obj, run, vertices, cells, part)
+                self._run_lines(obj, run, vertices, cells, part, solid)
                 return part
             block = block.astype(np.float64, copy=False)
             ids = check_finite_ids(self.error, block, run.first, run.keyword)
@@ -458,7 +564,7 @@ class _Parser:
         expected = _CELL_KEYWORD.get(obj.type)
         if cells is None or run.keyword != expected:
             if obj.type in ("TSolid", "LightTSolid") and run.keyword == "TRGL":
-                self._run_lines(obj, run, vertices, cells, part)
+                self._run_lines(obj, run, vertices, cells, part, solid)
                 return part
             raise self.error(f"{run.keyword} lines are not allowed in a {obj.type}", run.first)
         part = self._ensure_part(obj, part, vertices, run.first)
@@ -475,7 +581,7 @@ class _Parser:
                     raise BulkParseError
                 ids = ids.astype(np.int64)
         except BulkParseError:
-            self._run_lines(obj, run, vertices, cells, part)
+            self._run_lines(obj, run, vertices, cells, part, solid)
             return part
         cells.add_block(
             np.ascontiguousarray(ids),
@@ -507,8 +613,8 @@ class _Parser:
         rows, columns = np.nonzero(bad)
         counts = np.bincount(spec_of[columns], minlength=len(header.specs))
         for index in np.flatnonzero(counts).tolist():
-            entry = obj.nonfinite.setdefault((kind, index), [0, first_line + int(rows[0])])
-            entry[0] += int(counts[index])
+            count, line = obj.nonfinite.get((kind, index), (0, first_line + int(rows[0])))
+            obj.nonfinite[(kind, index)] = (count + int(counts[index]), line)
         return np.where(bad, no_data, values)
 
     def _report_nonfinite(self, obj: GocadObject) -> None:
@@ -526,19 +632,22 @@ class _Parser:
                 line,
             )
 
-    def _no_values(self, obj: GocadObject, n: int) -> Any:
+    def _no_values(self, obj: GocadObject, n: int) -> NDArray[np.float64]:
         return np.full((n, obj.point_header.n_values), np.nan)
 
     def _run_lines(
-        self, obj: GocadObject, run: Run, vertices: VertexTable, cells: CellTable | None, part: int
+        self,
+        obj: GocadObject,
+        run: Run,
+        vertices: VertexTable,
+        cells: CellTable | None,
+        part: int,
+        solid: _SolidDraft,
     ) -> None:
-        model_state: dict[str, Any] = {}
         for index in range(run.count):
             number = run.first + index
             text = self.source.text(number - 1).strip()
-            self._element_line(
-                obj, Line(number, text), run.keyword, vertices, cells, part, model_state
-            )
+            self._element_line(obj, Line(number, text), run.keyword, vertices, cells, part, solid)
 
     def _element_line(
         self,
@@ -548,104 +657,30 @@ class _Parser:
         vertices: VertexTable,
         cells: CellTable | None,
         part: int,
-        model_state: dict[str, Any],
+        solid: _SolidDraft,
     ) -> int:
-        tokens = item.text.split()
+        """One line of an object's body; the part (TFACE, ILINE, ...) the next lines go to."""
         number = item.number
-        n_values = obj.point_header.n_values
         try:
             if keyword in ("VRTX", "PVRTX"):
                 part = self._ensure_part(obj, part, vertices, number)
-                flag, tokens = _strip_flags(tokens)
-                count = 5 + (n_values if keyword == "PVRTX" else 0)
-                if len(tokens) < count:
-                    raise self.error(
-                        f"{keyword} needs {count - 1} numbers, found {len(tokens) - 1}", number
-                    )
-                if len(tokens) > count:
-                    self.warn(
-                        f"{keyword} has {len(tokens) - count} extra value(s); ignored", number
-                    )
-                xyz = (parse_float(tokens[2]), parse_float(tokens[3]), parse_float(tokens[4]))
-                values = [parse_float(t) for t in tokens[5:count]] if keyword == "PVRTX" else None
-                if values is not None and not all(map(math.isfinite, values)):
-                    values = self._finite(obj, "point", np.array([values]), number)[0].tolist()
-                if values is None and n_values:
-                    values = [np.nan] * n_values
-                vertices.add(parse_int(tokens[1]), xyz, None, values, flag, number)
+                self._vertex_line(obj, item, keyword, vertices)
             elif keyword in ("ATOM", "PATOM", "SHAREDVRTX", "SHAREDPVRTX"):
                 part = self._ensure_part(obj, part, vertices, number)
-                flag, tokens = _strip_flags(tokens)
-                with_values = keyword in ("PATOM", "SHAREDPVRTX")
-                if len(tokens) < 3:
-                    raise self.error(f"{keyword} needs a new id and the id it refers to", number)
-                values = None
-                if with_values and n_values:
-                    if len(tokens) < 3 + n_values:
-                        raise self.error(
-                            f"{keyword} needs {n_values} property values, found {len(tokens) - 3}",
-                            number,
-                        )
-                    values = [parse_float(t) for t in tokens[3 : 3 + n_values]]
-                    if not all(map(math.isfinite, values)):
-                        values = self._finite(obj, "point", np.array([values]), number)[0].tolist()
-                vertices.add(parse_int(tokens[1]), None, parse_int(tokens[2]), values, flag, number)
+                self._atom_line(obj, item, keyword, vertices)
             elif keyword in _PART_KEYWORDS:
-                name = item.text[len(keyword) :].strip()
-                if keyword == "SUBVSET" or obj.type in ("TSurf", "PLine", "TSolid", "LightTSolid"):
-                    if obj.type in ("TSolid", "LightTSolid") and model_state.get("in_model"):
-                        self._tsolid_model_line(obj, item, keyword, model_state)
-                    else:
-                        part = self._new_part(obj, _unquote(name), vertices)
-                        obj.declared_parts += 1
-                else:
-                    self.warn(f"{keyword} is not used in a {obj.type}; ignored", number)
+                part = self._part_line(obj, item, keyword, vertices, part, solid)
             elif cells is not None and keyword == _CELL_KEYWORD.get(obj.type):
                 part = self._ensure_part(obj, part, vertices, number)
-                width, n_cell = cells.width, cells.n_values
-                if len(tokens) < 1 + width + n_cell:
-                    raise self.error(
-                        f"{keyword} needs {width} vertex ids"
-                        + (f" and {n_cell} values" if n_cell else "")
-                        + f", found {len(tokens) - 1} entries",
-                        number,
-                    )
-                if len(tokens) > 1 + width + n_cell:
-                    self.warn(f"{keyword} has extra entries; ignored", number)
-                ids = [parse_int(t) for t in tokens[1 : 1 + width]]
-                values = [parse_float(t) for t in tokens[1 + width : 1 + width + n_cell]]
-                if not all(map(math.isfinite, values)):
-                    values = self._finite(obj, "cell", np.array([values]), number)[0].tolist()
-                cells.add(ids, values, part, number)
+                self._cell_line(obj, item, keyword, cells, part)
             elif keyword == "# CTETRA" or (keyword == "#" and item.text.startswith("# CTETRA")):
-                if cells is None or cells.count == 0:
-                    raise self.error("'# CTETRA' before any TETRA", number)
-                # entries like -(boundary)"fracture 1": quotes do not end an entry
-                parts = _CTETRA_ENTRY.findall(item.text)[2:]
-                if len(parts) > 5:
-                    raise self.error(
-                        f"'# CTETRA' needs a region and 4 face entries, found {len(parts)} entries",
-                        number,
-                    )
-                if obj.ctetra and obj.ctetra[-1][0] == cells.count - 1:
-                    self.warn("a second '# CTETRA' line for one TETRA replaces the first", number)
-                    obj.ctetra.pop()
-                region = _unquote(parts[0]) if parts else ""
-                obj.ctetra.append((cells.count - 1, region, parts[1:5], number))
-            elif keyword == "BSTONE":
-                if len(tokens) < 2:
-                    raise self.error("BSTONE needs a vertex id", number)
-                obj.bstones.append((parse_int(tokens[1]), number))
-            elif keyword == "BORDER":
-                if len(tokens) < 4:
-                    raise self.error("BORDER needs an id and two vertex ids", number)
-                obj.borders.append(
-                    (parse_int(tokens[1]), parse_int(tokens[2]), parse_int(tokens[3]), number)
-                )
+                self._ctetra_line(obj, item, cells)
+            elif keyword in ("BSTONE", "BORDER"):
+                self._border_line(obj, item, keyword)
             elif keyword in _SKIP_BLOCKS:
                 self._skip_block(keyword, number)
             elif obj.type in ("TSolid", "LightTSolid"):
-                self._tsolid_model_line(obj, item, keyword, model_state)
+                self._tsolid_model_line(obj, item, keyword, solid)
             else:
                 self.warn(f"unknown keyword {keyword!r} in a {obj.type}; line kept", number)
                 obj.extra_lines.append(item.text)
@@ -654,6 +689,123 @@ class _Parser:
                 raise
             raise self.error(f"{keyword}: {exc}", number) from None
         return part
+
+    def _vertex_line(
+        self, obj: GocadObject, item: Line, keyword: str, vertices: VertexTable
+    ) -> None:
+        """``VRTX`` / ``PVRTX <id> x y z [values] [CNXYZ|XYZ]``."""
+        number = item.number
+        n_values = obj.point_header.n_values
+        flag, tokens = _strip_flags(item.text.split())
+        count = 5 + (n_values if keyword == "PVRTX" else 0)
+        if len(tokens) < count:
+            raise self.error(
+                f"{keyword} needs {count - 1} numbers, found {len(tokens) - 1}", number
+            )
+        if len(tokens) > count:
+            self.warn(f"{keyword} has {len(tokens) - count} extra value(s); ignored", number)
+        xyz = (parse_float(tokens[2]), parse_float(tokens[3]), parse_float(tokens[4]))
+        values = [parse_float(t) for t in tokens[5:count]] if keyword == "PVRTX" else None
+        if values is not None and not all(map(math.isfinite, values)):
+            values = self._finite(obj, "point", np.array([values]), number)[0].tolist()
+        if values is None and n_values:
+            values = [np.nan] * n_values
+        vertices.add(parse_int(tokens[1]), xyz, None, values, flag, number)
+
+    def _atom_line(self, obj: GocadObject, item: Line, keyword: str, vertices: VertexTable) -> None:
+        """``ATOM`` / ``PATOM`` / ``SHAREDVRTX`` / ``SHAREDPVRTX <new id> <id> [values]``."""
+        number = item.number
+        n_values = obj.point_header.n_values
+        flag, tokens = _strip_flags(item.text.split())
+        with_values = keyword in ("PATOM", "SHAREDPVRTX")
+        if len(tokens) < 3:
+            raise self.error(f"{keyword} needs a new id and the id it refers to", number)
+        values = None
+        if with_values and n_values:
+            if len(tokens) < 3 + n_values:
+                raise self.error(
+                    f"{keyword} needs {n_values} property values, found {len(tokens) - 3}",
+                    number,
+                )
+            values = [parse_float(t) for t in tokens[3 : 3 + n_values]]
+            if not all(map(math.isfinite, values)):
+                values = self._finite(obj, "point", np.array([values]), number)[0].tolist()
+        vertices.add(parse_int(tokens[1]), None, parse_int(tokens[2]), values, flag, number)
+
+    def _part_line(
+        self,
+        obj: GocadObject,
+        item: Line,
+        keyword: str,
+        vertices: VertexTable,
+        part: int,
+        solid: _SolidDraft,
+    ) -> int:
+        """``TFACE`` / ``3DFACE`` / ``ILINE`` / ``TVOLUME`` / ``SUBVSET``: a new part (a TFACE in
+        a TSolid's MODEL section is one of the model's)."""
+        if keyword == "SUBVSET" or obj.type in ("TSurf", "PLine", "TSolid", "LightTSolid"):
+            if obj.type in ("TSolid", "LightTSolid") and solid.in_model:
+                self._tsolid_model_line(obj, item, keyword, solid)
+                return part
+            obj.declared_parts += 1
+            name = _unquote(item.text[len(keyword) :].strip())
+            return self._new_part(obj, name, vertices, item.number)
+        self.warn(f"{keyword} is not used in a {obj.type}; ignored", item.number)
+        return part
+
+    def _cell_line(
+        self, obj: GocadObject, item: Line, keyword: str, cells: CellTable, part: int
+    ) -> None:
+        """``TRGL`` / ``SEG`` / ``TETRA <vertex ids> [values]``."""
+        tokens = item.text.split()
+        number = item.number
+        width, n_cell = cells.width, cells.n_values
+        if len(tokens) < 1 + width + n_cell:
+            raise self.error(
+                f"{keyword} needs {width} vertex ids"
+                + (f" and {n_cell} values" if n_cell else "")
+                + f", found {len(tokens) - 1} entries",
+                number,
+            )
+        if len(tokens) > 1 + width + n_cell:
+            self.warn(f"{keyword} has extra entries; ignored", number)
+        ids = [parse_int(t) for t in tokens[1 : 1 + width]]
+        values = [parse_float(t) for t in tokens[1 + width : 1 + width + n_cell]]
+        if not all(map(math.isfinite, values)):
+            values = self._finite(obj, "cell", np.array([values]), number)[0].tolist()
+        cells.add(ids, values, part, number)
+
+    def _ctetra_line(self, obj: GocadObject, item: Line, cells: CellTable | None) -> None:
+        """``# CTETRA <region> <4 faces>``: what the faces of the last TETRA lie on."""
+        number = item.number
+        if cells is None or cells.count == 0:
+            raise self.error("'# CTETRA' before any TETRA", number)
+        # entries like -(boundary)"fracture 1": quotes do not end an entry
+        parts = _CTETRA_ENTRY.findall(item.text)[2:]
+        if len(parts) > 5:
+            raise self.error(
+                f"'# CTETRA' needs a region and 4 face entries, found {len(parts)} entries",
+                number,
+            )
+        if obj.ctetra and obj.ctetra[-1].cell == cells.count - 1:
+            self.warn("a second '# CTETRA' line for one TETRA replaces the first", number)
+            obj.ctetra.pop()
+        region = _unquote(parts[0]) if parts else ""
+        obj.ctetra.append(CTetra(cells.count - 1, region, tuple(parts[1:5]), number))
+
+    def _border_line(self, obj: GocadObject, item: Line, keyword: str) -> None:
+        """``BSTONE <vertex id>`` or ``BORDER <id> <vertex id> <vertex id>``."""
+        tokens = item.text.split()
+        if keyword == "BSTONE":
+            if len(tokens) < 2:
+                raise self.error("BSTONE needs a vertex id", item.number)
+            obj.bstones.append(BStone(parse_int(tokens[1]), item.number))
+            return
+        if len(tokens) < 4:
+            raise self.error("BORDER needs an id and two vertex ids", item.number)
+        obj.borders.append(
+            Border(parse_int(tokens[1]), parse_int(tokens[2]), parse_int(tokens[3]), item.number)
+        )
 
     def _skip_block(self, keyword: str, number: int) -> None:
         end = _SKIP_BLOCKS[keyword]
@@ -668,138 +820,120 @@ class _Parser:
 
     # -- TSolid model section -------------------------------------------------------------------
     def _tsolid_model_line(
-        self, obj: GocadObject, item: Line, keyword: str, state: dict[str, Any]
+        self, obj: GocadObject, item: Line, keyword: str, solid: _SolidDraft
     ) -> None:
-        model = obj.model
         tokens = split_tokens(item.text)
         if keyword == "MODEL":
-            state["in_model"] = True
-            model.setdefault("surfaces", [])
-            return
-        if keyword == "SURFACE":
-            model.setdefault("surfaces", []).append(
-                {"name": item.text[len(keyword) :].strip().strip('"'), "tfaces": []}
-            )
+            solid.in_model = True
+        elif keyword == "SURFACE":
+            solid.surfaces.append((item.text[len(keyword) :].strip().strip('"'), []))
         elif keyword == "TFACE":
-            surfaces = model.setdefault("surfaces", [])
-            if not surfaces:
+            if not solid.surfaces:
                 raise self.error("TFACE before any SURFACE in the MODEL section", item.number)
-            tface_id = parse_int(tokens[1]) if len(tokens) > 1 else len(model.get("tfaces", [])) + 1
-            surfaces[-1]["tfaces"].append({"id": tface_id, "key": None, "triangles": []})
-        elif keyword == "KEYVERTICES":
-            current = self._current_tface(model, item)
+            count = sum(len(tfaces) for _, tfaces in solid.surfaces)
+            tface_id = parse_int(tokens[1]) if len(tokens) > 1 else count + 1
+            solid.surfaces[-1][1].append(_SolidTFaceDraft(tface_id))
+        elif keyword in ("KEYVERTICES", "TRGL"):
+            current = self._current_tface(solid, item)
             if len(tokens) < 4:
-                raise self.error("KEYVERTICES needs 3 vertex ids", item.number)
-            current["key"] = ([parse_int(t) for t in tokens[1:4]], item.number)
-        elif keyword == "TRGL":
-            current = self._current_tface(model, item)
-            if len(tokens) < 4:
-                raise self.error("TRGL needs 3 vertex ids", item.number)
-            current["triangles"].append(([parse_int(t) for t in tokens[1:4]], item.number))
+                raise self.error(f"{keyword} needs 3 vertex ids", item.number)
+            a, b, c = (parse_int(t) for t in tokens[1:4])
+            triangle = SolidTriangle((a, b, c), item.number)
+            if keyword == "TRGL":
+                current.triangles.append(triangle)
+            else:
+                current.key = triangle
         elif keyword == "MODEL_REGION":
             if len(tokens) < 3:
                 raise self.error("MODEL_REGION needs a name and a signed TFACE id", item.number)
-            sign_text = tokens[-1]
-            model.setdefault("regions", []).append([" ".join(tokens[1:-1]), parse_int(sign_text)])
+            solid.regions.append(ModelRegion(" ".join(tokens[1:-1]), parse_int(tokens[-1])))
         else:
             self.warn(f"unknown keyword {keyword!r} in a {obj.type}; line kept", item.number)
             obj.extra_lines.append(item.text)
 
-    def _current_tface(self, model: dict[str, Any], item: Line) -> dict[str, Any]:
-        surfaces = model.get("surfaces") or []
-        if not surfaces or not surfaces[-1]["tfaces"]:
+    def _current_tface(self, solid: _SolidDraft, item: Line) -> _SolidTFaceDraft:
+        if not solid.surfaces or not solid.surfaces[-1][1]:
             raise self.error(f"{_keyword(item.text)} before any TFACE of the MODEL", item.number)
-        tface: dict[str, Any] = surfaces[-1]["tfaces"][-1]
-        return tface
+        return solid.surfaces[-1][1][-1]
 
     # -- Model3d header -------------------------------------------------------------------------
-    def _model3d_line(self, obj: GocadObject, item: Line, state: dict[str, Any]) -> None:
+    def _model3d_line(self, obj: GocadObject, item: Line, header: _Model3dDraft) -> None:
         keyword = _keyword(item.text)
-        model = obj.model
         text = item.text
         if keyword == "TSURF":
             name = _unquote(text[len(keyword) :].strip())
-            if name in model.setdefault("tsurfs", []):
+            if name in header.tsurfs:
                 self.warn(f"TSURF {name!r} is listed twice", item.number)
             else:
-                model["tsurfs"].append(name)
-            state.pop("list", None)
-            return
-        if keyword == "TFACE":
+                header.tsurfs.append(name)
+            header.current = None
+        elif keyword == "TFACE":
             tokens = text.split(None, 3)
             if len(tokens) < 4:
                 raise self.error(
                     "TFACE needs an id, a geological type and a TSurf name", item.number
                 )
-            entry = {
-                "id": parse_int(tokens[1]),
-                "type": tokens[2],
-                "tsurf": _unquote(tokens[3].strip()),
-                "key": [],
-                "line": item.number,
-            }
-            model.setdefault("tfaces", []).append(entry)
-            state["key_for"] = entry
-            state.pop("list", None)
-            return
-        if keyword in ("REGION", "SURFACE", "LAYER", "FAULT_BLOCK", "FAULT", "BOUNDARY", "UNIT"):
-            tokens = text.split(None, 2)
-            if keyword == "REGION":
-                if len(tokens) < 3:
-                    raise self.error("REGION needs an id and a name", item.number)
-                entry = {
-                    "id": parse_int(tokens[1]),
-                    "name": _unquote(tokens[2].strip()),
-                    "items": [],
-                    "line": item.number,
-                }
-            else:
-                entry = {
-                    "name": _unquote(text[len(keyword) :].strip()),
-                    "items": [],
-                    "line": item.number,
-                }
-            model.setdefault("lists", []).append((keyword, entry))
-            state["list"] = entry
-            state.pop("key_for", None)
-            return
-        numbers = text.split()
-        key_for = state.get("key_for")
-        if key_for is not None and len(key_for["key"]) < 3:
+            entry = _TFaceDraft(
+                parse_int(tokens[1]), tokens[2], _unquote(tokens[3].strip()), item.number
+            )
+            header.tfaces.append(entry)
+            header.key_for, header.current = entry, None
+        elif keyword in _MODEL3D_LISTS:
+            header.current = self._model3d_list(keyword, item)
+            header.lists.append(header.current)
+            header.key_for = None
+        elif not self._model3d_numbers(item, header):
+            self.warn(f"unknown line in the Model3d header: {text[:40]!r}; kept", item.number)
+            obj.extra_lines.append(text)
+
+    def _model3d_list(self, keyword: str, item: Line) -> _ListDraft:
+        """The list a ``REGION <id> <name>`` (or ``LAYER <name>``, ...) line opens."""
+        if keyword != "REGION":
+            return _ListDraft(keyword, _unquote(item.text[len(keyword) :].strip()), item.number)
+        tokens = item.text.split(None, 2)
+        if len(tokens) < 3:
+            raise self.error("REGION needs an id and a name", item.number)
+        return _ListDraft(
+            keyword, _unquote(tokens[2].strip()), item.number, region_id=parse_int(tokens[1])
+        )
+
+    def _model3d_numbers(self, item: Line, header: _Model3dDraft) -> bool:
+        """A key-triangle line or a line of list ids; False when the line is neither."""
+        numbers = item.text.split()
+        key_for = header.key_for
+        if key_for is not None and len(key_for.key) < 3:
             try:
                 point = [parse_float(t) for t in numbers]
             except ValueError as exc:
                 raise self.error(f"key triangle: {exc}", item.number) from None
             if len(point) != 3:
                 raise self.error("a key-triangle line needs 3 coordinates", item.number)
-            key_for["key"].append(point)
-            return
-        current = state.get("list")
-        if current is not None and not current.get("closed"):
-            for token in numbers:
-                try:
-                    value = parse_int(token)
-                except ValueError as exc:
-                    raise self.error(
-                        f"{exc} in the list of {current['name']!r}", item.number
-                    ) from None
-                if value == 0:
-                    current["closed"] = True
-                    break
-                current["items"].append(value)
-            return
-        self.warn(f"unknown line in the Model3d header: {text[:40]!r}; kept", item.number)
-        obj.extra_lines.append(text)
+            key_for.key.append((point[0], point[1], point[2]))
+            return True
+        current = header.current
+        if current is None or current.closed:
+            return False
+        for token in numbers:
+            try:
+                value = parse_int(token)
+            except ValueError as exc:
+                raise self.error(f"{exc} in the list of {current.name!r}", item.number) from None
+            if value == 0:
+                current.closed = True
+                break
+            current.items.append(value)
+        return True
 
-    def _finish_model3d(self, obj: GocadObject, state: dict[str, Any]) -> None:
-        for entry in obj.model.get("tfaces", []):
-            if len(entry["key"]) != 3:
+    def _finish_model3d(self, header: _Model3dDraft) -> Model3dHeader:
+        for entry in header.tfaces:
+            if len(entry.key) != 3:
                 raise self.error(
-                    f"TFACE {entry['id']} needs a key triangle of 3 coordinate lines", entry["line"]
+                    f"TFACE {entry.id} needs a key triangle of 3 coordinate lines", entry.line
                 )
-        for keyword, entry in obj.model.get("lists", []):
-            if not entry.pop("closed", False):
-                self.warn(f"{keyword} {entry['name']!r} list does not end with 0", entry["line"])
+        for draft in header.lists:
+            if not draft.closed:
+                self.warn(f"{draft.keyword} {draft.name!r} list does not end with 0", draft.line)
+        return header.freeze()
 
     # -- groups ---------------------------------------------------------------------------------
     def _parse_group(self, obj: GocadObject) -> None:
@@ -828,12 +962,14 @@ class _Parser:
             elif keyword == "END":
                 return
             elif keyword == "TYPE":
-                obj.model["member_type"] = item.text[len(keyword) :].strip()
+                obj.member_type = item.text[len(keyword) :].strip()
             elif not self._common(obj, item):
                 self.warn(f"unknown keyword {keyword!r} in a group; line kept", item.number)
                 obj.extra_lines.append(item.text)
 
 
+#: Model3d header keywords that open a list of ids ended by 0.
+_MODEL3D_LISTS = ("REGION", "SURFACE", "LAYER", "FAULT_BLOCK", "FAULT", "BOUNDARY", "UNIT")
 _CRS_KEYS = {
     "NAME",
     "PROJECTION",

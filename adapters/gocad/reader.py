@@ -14,8 +14,9 @@
 from __future__ import annotations
 
 import warnings
+from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,8 +27,9 @@ from geobrep.adapters.gocad.model3d import attach_model3d
 from geobrep.adapters.gocad.objects import gocad_section
 from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.adapters.gocad.parser import GROUP_TYPES, GocadObject, GocadWarning, parse_source
+from geobrep.adapters.gocad.records import CrsBlock, ErrorFactory, SolidSurface
 from geobrep.adapters.gocad.regions import TetFaces, root_vertices
-from geobrep.adapters.gocad.tables import ResolvedVertices
+from geobrep.adapters.gocad.tables import IdLookup, ResolvedVertices
 from geobrep.errors import EntityValidationError, FormatError, TopologyError
 from geobrep.host.capabilities import SKIPPED_ON_READ
 from geobrep.model.crs import CRS
@@ -60,6 +62,15 @@ _KIND_OF_TYPE = {
 GocadReadOptions = GocadOptions
 
 
+class _EntityFields(TypedDict):
+    """The fields every entity read from a GOCAD object gets."""
+
+    id: int
+    name: str
+    kind: str | None
+    metadata: dict[str, Any]  # JSON: "gocad" (what a writer restores) and "color"
+
+
 def kind_of(geological_type: str | None) -> str | None:
     """geobrep ``kind`` for a GOCAD GEOLOGICAL_TYPE (``*fault`` → ``fault``, ``top`` → horizon)."""
     if geological_type is None:
@@ -70,15 +81,16 @@ def kind_of(geological_type: str | None) -> str | None:
     return _KIND_OF_TYPE.get(lowered, lowered)
 
 
-def crs_from_block(block: dict[str, Any]) -> CRS:
+def crs_from_block(block: CrsBlock) -> CRS:
     """A :class:`CRS` from a parsed ``GOCAD_ORIGINAL_COORDINATE_SYSTEM`` block."""
     extra = {
         key.lower(): value
         for key, value in block.items()
         if key not in ("NAME", "AXIS_NAME", "AXIS_UNIT", "ZPOSITIVE")
     }
+    name = block.get("NAME")
     return CRS(
-        name=block.get("NAME"),
+        name=name if isinstance(name, str) else None,
         axis_names=tuple(block.get("AXIS_NAME", ("X", "Y", "Z"))),
         axis_units=tuple(block.get("AXIS_UNIT", ("m", "m", "m"))),
         z_positive="down" if block.get("ZPOSITIVE") == "Depth" else "up",
@@ -91,7 +103,7 @@ def _properties(
     values: NDArray[np.float64],
     class_headers: dict[str, dict[str, str]],
     where: str,
-    error: Any,
+    error: ErrorFactory,
 ) -> dict[str, Property]:
     out: dict[str, Property] = {}
     column = 0
@@ -120,7 +132,7 @@ class _Builder:
         self.options = options
         self.path = source.path
         self.entities: list[Entity] = []
-        self.scene_crs: dict[str, Any] | None = None
+        self.scene_crs: CrsBlock | None = None
         self.surface_of_object: dict[int, int] = {}
         self.skipped: list[str] = []
 
@@ -156,7 +168,7 @@ class _Builder:
                     f"{len(models)} Model3d objects: only the first with TFACEs defines "
                     "the topology"
                 )
-            model = next((m for m in models if m.model.get("tfaces")), models[0])
+            model = next((m for m in models if m.model3d.tfaces), models[0])
             name = model.name
             self._kinds_from_model(model)
             surfaces = [e for e in self.entities if isinstance(e, Surface)]
@@ -199,8 +211,8 @@ class _Builder:
     def _kinds_from_model(self, model: GocadObject) -> None:
         """Surfaces without a GEOLOGICAL_TYPE take the type of their header TFACEs."""
         types: dict[str, str] = {}
-        for entry in model.model.get("tfaces", []):
-            types.setdefault(entry["tsurf"], entry["type"])
+        for entry in model.model3d.tfaces:
+            types.setdefault(entry.tsurf, entry.type)
         for index, entity in enumerate(self.entities):
             if not isinstance(entity, Surface) or entity.kind is not None:
                 continue
@@ -213,11 +225,10 @@ class _Builder:
                 self.entities[index] = entity.replace(kind=kind_of(found))
 
     def add_object(
-        self, obj: GocadObject, parent_crs: dict[str, Any] | None, models: list[GocadObject]
+        self, obj: GocadObject, parent_crs: CrsBlock | None, models: list[GocadObject]
     ) -> Group | None:
         if obj.crs is None and parent_crs is not None:
-            obj.crs = dict(parent_crs)
-            obj.model["inherited_crs"] = True
+            obj = replace(obj, crs=dict(parent_crs), inherited_crs=True)
         if obj.type in GROUP_TYPES:
             start = self.next_id()
             children = []
@@ -248,14 +259,14 @@ class _Builder:
         return None
 
     def _z_sign(self, obj: GocadObject) -> float:
-        return -1.0 if (obj.crs or {}).get("ZPOSITIVE") == "Depth" else 1.0
+        return -1.0 if obj.crs is not None and obj.crs.get("ZPOSITIVE") == "Depth" else 1.0
 
     def _object_metadata(self, obj: GocadObject, _: int = 0) -> dict[str, Any]:
         meta: dict[str, Any] = {"type": obj.type, "version": obj.version}
         meta["header"] = [[k, v] for k, v in obj.header]
         if (
             obj.crs is not None
-            and not obj.model.get("inherited_crs")
+            and not obj.inherited_crs
             and (
                 self.scene_crs is None or crs_from_block(obj.crs) != crs_from_block(self.scene_crs)
             )
@@ -269,11 +280,11 @@ class _Builder:
             meta["class_headers"] = obj.class_headers
         if obj.extra_lines:
             meta["extra_lines"] = obj.extra_lines
-        if "member_type" in obj.model:
-            meta["member_type"] = obj.model["member_type"]
+        if obj.member_type is not None:
+            meta["member_type"] = obj.member_type
         return meta
 
-    def _common_fields(self, obj: GocadObject) -> dict[str, Any]:
+    def _common_fields(self, obj: GocadObject) -> _EntityFields:
         metadata: dict[str, Any] = {"gocad": self._object_metadata(obj)}
         for key in _COLOR_KEYS:
             value = obj.header_value(key)
@@ -283,8 +294,9 @@ class _Builder:
                     metadata["color"] = color
                 break
         geo_type = obj.geology.get("GEOLOGICAL_TYPE")
+        geo_type = geo_type if isinstance(geo_type, str) else None
         kind = obj.header_value("geobrep_kind") or kind_of(geo_type)  # kinds GOCAD has no type for
-        return {"name": obj.name, "kind": kind, "metadata": metadata}
+        return {"id": self.next_id(), "name": obj.name, "kind": kind, "metadata": metadata}
 
     # -- one object -----------------------------------------------------------------------------
     def _add_entity(self, obj: GocadObject) -> None:
@@ -312,7 +324,6 @@ class _Builder:
                 values=vertices.ids, description="vertex ids of the GOCAD file"
             )
         fields = self._common_fields(obj)
-        fields["id"] = self.next_id()
         lookup = vertices.lookup
         cells = obj.cells
         if obj.type == "VSet":
@@ -348,18 +359,18 @@ class _Builder:
                 obj, xyz, index, parts, names, point_data, cell_data, fields, lookup, vertices
             )
 
-    def _hints(self, obj: GocadObject, lookup: Any, fields: dict[str, Any]) -> None:
+    def _hints(self, obj: GocadObject, lookup: IdLookup, fields: _EntityFields) -> None:
         """BSTONE / BORDER lines as vertex indices in ``metadata["gocad"]``."""
         gocad = fields["metadata"]["gocad"]
         if obj.bstones:
-            ids = np.array([b[0] for b in obj.bstones], dtype=np.int64)
-            lines = np.array([b[1] for b in obj.bstones], dtype=np.int64)
+            ids = np.array([b.vertex_id for b in obj.bstones], dtype=np.int64)
+            lines = np.array([b.line for b in obj.bstones], dtype=np.int64)
             gocad["bstones"] = lookup.require(ids[:, None], lines, "BSTONE", self.error)[
                 :, 0
             ].tolist()
         if obj.borders:
-            ids = np.array([[b[1], b[2]] for b in obj.borders], dtype=np.int64)
-            lines = np.array([b[3] for b in obj.borders], dtype=np.int64)
+            ids = np.array([[b.v0, b.v1] for b in obj.borders], dtype=np.int64)
+            lines = np.array([b.line for b in obj.borders], dtype=np.int64)
             gocad["borders"] = lookup.require(ids, lines, "BORDER", self.error).tolist()
 
     def _polyline(
@@ -370,7 +381,7 @@ class _Builder:
         parts: NDArray[np.int64],
         point_data: dict[str, Property],
         cell_data: dict[str, Property],
-        fields: dict[str, Any],
+        fields: _EntityFields,
     ) -> PolyLine:
         n_seg = segments.shape[0]
         if n_seg == 0:
@@ -420,12 +431,12 @@ class _Builder:
         names: tuple[str, ...],
         point_data: dict[str, Property],
         cell_data: dict[str, Property],
-        fields: dict[str, Any],
-        lookup: Any,
+        fields: _EntityFields,
+        lookup: IdLookup,
         vertices: ResolvedVertices,
     ) -> None:
         gocad = fields["metadata"]["gocad"]
-        model = obj.model
+        model = obj.solid_model
         codes: NDArray[np.int64] | None = None
         ctetra_names: list[tuple[int, str]] = []
         if obj.ctetra:
@@ -435,9 +446,9 @@ class _Builder:
                 description="GOCAD '# CTETRA' faces: 0 none, +k/-k side of surface k-1",
                 metadata={"gocad": {"surfaces": surfaces}},
             )
-        if model.get("regions"):
-            gocad["model_regions"] = model["regions"]
-        if (codes is not None or model.get("regions")) and tetra.shape[0]:
+        if model.regions:
+            gocad["model_regions"] = [[r.name, r.signed_tface] for r in model.regions]
+        if (codes is not None or model.regions) and tetra.shape[0]:
             faces = TetFaces(tetra, root_vertices(vertices.atom_of))
             seeds = self._seeds(obj, faces, xyz, lookup)
             if not obj.declared_parts:  # no TVOLUME: the regions are what faces and seeds say
@@ -468,28 +479,27 @@ class _Builder:
                 **fields,
             )
         )
-        for surface in model.get("surfaces", []):
-            if not surface["tfaces"]:
-                self.warn(f"MODEL surface {surface['name']!r} has no TFACE; skipped", obj.line)
-                self.skipped.append(f"MODEL surface {surface['name']!r} of {obj.name!r}: no TFACE")
+        for surface in model.surfaces:
+            if not surface.tfaces:
+                self.warn(f"MODEL surface {surface.name!r} has no TFACE; skipped", obj.line)
+                self.skipped.append(f"MODEL surface {surface.name!r} of {obj.name!r}: no TFACE")
                 continue
             self._tsolid_surface(obj, surface, xyz, lookup, tet_id)
 
     def _seeds(
-        self, obj: GocadObject, faces: TetFaces, xyz: NDArray[np.float64], lookup: Any
+        self, obj: GocadObject, faces: TetFaces, xyz: NDArray[np.float64], lookup: IdLookup
     ) -> list[tuple[str, int]]:
         """``(name, tetrahedron)`` of each MODEL_REGION whose seed face is found."""
-        tfaces = {
-            t["id"]: t for surface in obj.model.get("surfaces", []) for t in surface["tfaces"]
-        }
+        tfaces = {t.id: t for surface in obj.solid_model.surfaces for t in surface.tfaces}
         found: list[tuple[str, int]] = []
-        for name, signed in obj.model.get("regions", []):
+        for region in obj.solid_model.regions:
+            name, signed = region.name, region.signed_tface
             tface = tfaces.get(abs(signed))
             what = f"MODEL_REGION {name!r} {signed:+d}"
-            if tface is None or tface["key"] is None or signed == 0:
+            if tface is None or tface.key is None or signed == 0:
                 self.warn(f"{what}: no TFACE {abs(signed)} with KEYVERTICES; ignored", obj.line)
                 continue
-            ids, line = tface["key"]
+            ids, line = tface.key
             key = lookup.require(
                 np.asarray([ids], dtype=np.int64), np.asarray([line]), "KEYVERTICES", self.error
             )[0]
@@ -510,17 +520,17 @@ class _Builder:
         faces: TetFaces,
         codes: NDArray[np.int64] | None,
         seeds: list[tuple[str, int]],
-        lookup: Any,
+        lookup: IdLookup,
     ) -> tuple[NDArray[np.int64], tuple[str, ...]]:
         """Regions as connected sets of tetrahedra separated by model-surface faces (``#
         CTETRA`` codes and ``MODEL`` triangles), named by their MODEL_REGION seeds, else by the
         ``# CTETRA`` region most of their tetrahedra name; sets with one name are one region."""
         barrier = codes != 0 if codes is not None else np.zeros((faces.n_cells, 4), dtype=bool)
         triangles = [
-            (tri, line)
-            for surface in obj.model.get("surfaces", [])
-            for tface in surface["tfaces"]
-            for tri, line in tface["triangles"]
+            triangle
+            for surface in obj.solid_model.surfaces
+            for tface in surface.tfaces
+            for triangle in tface.triangles
         ]
         if triangles:
             ids = np.asarray([t for t, _ in triangles], dtype=np.int64)
@@ -575,57 +585,52 @@ class _Builder:
     def _tsolid_surface(
         self,
         obj: GocadObject,
-        surface: dict[str, Any],
+        surface: SolidSurface,
         xyz: NDArray[np.float64],
-        lookup: Any,
+        lookup: IdLookup,
         tet_id: int,
     ) -> None:
-        rows: list[list[int]] = []
+        rows: list[tuple[int, int, int]] = []
         lines: list[int] = []
         labels: list[int] = []
-        keys: list[Any] = []
-        for label, tface in enumerate(surface["tfaces"]):
-            for tri, line in tface["triangles"]:
+        for label, tface in enumerate(surface.tfaces):
+            for tri, line in tface.triangles:
                 rows.append(tri)
                 lines.append(line)
                 labels.append(label)
-            keys.append(tface["key"])
         ids = np.asarray(rows, dtype=np.int64).reshape(-1, 3)
         index = lookup.require(ids, np.asarray(lines, dtype=np.int64), "TRGL", self.error)
         used, compact = np.unique(index, return_inverse=True)
         key_faces: list[int | None] = []
-        for label, key in enumerate(keys):
+        for label, tface in enumerate(surface.tfaces):
+            key = tface.key
             if key is None:
-                tface = surface["tfaces"][label]["id"]
-                self.warn(f"TFACE {tface} of MODEL surface {surface['name']!r} has no KEYVERTICES")
+                self.warn(f"TFACE {tface.id} of MODEL surface {surface.name!r} has no KEYVERTICES")
                 key_faces.append(None)
                 continue
             key_index = lookup.require(
-                np.asarray([key[0]], dtype=np.int64),
-                np.asarray([key[1]]),
+                np.asarray([key.ids], dtype=np.int64),
+                np.asarray([key.line]),
                 "KEYVERTICES",
                 self.error,
             )[0]
             match = np.flatnonzero((index == key_index).all(axis=1) & (np.asarray(labels) == label))
             if not match.size:
-                self.warn(
-                    f"KEYVERTICES of TFACE {surface['tfaces'][label]['id']} is no TRGL of it",
-                    key[1],
-                )
+                self.warn(f"KEYVERTICES of TFACE {tface.id} is no TRGL of it", key.line)
             key_faces.append(int(match[0]) if match.size else None)
         self.entities.append(
             Surface(
                 id=self.next_id(),
-                name=surface["name"],
+                name=surface.name,
                 vertices=xyz[used],
                 faces=compact.reshape(-1, 3),
                 patch_labels=np.asarray(labels, dtype=np.int64),
-                patch_names=tuple(str(t["id"]) for t in surface["tfaces"]) or ("0",),
+                patch_names=tuple(str(t.id) for t in surface.tfaces) or ("0",),
                 metadata={
                     "gocad": {
                         "type": "TSolid.SURFACE",
                         "tsolid": tet_id,
-                        "tface_ids": [t["id"] for t in surface["tfaces"]],
+                        "tface_ids": [t.id for t in surface.tfaces],
                         "tsolid_vertices": used.tolist(),
                         "key_triangles": key_faces,
                     }
@@ -639,8 +644,8 @@ def _majority_names(obj: GocadObject, component: NDArray[np.int64], count: int) 
     none)."""
     if not obj.ctetra:
         return [""] * count
-    cells = np.array([c for c, _, _, _ in obj.ctetra], dtype=np.int64)
-    labels, which = np.unique([r for _, r, _, _ in obj.ctetra], return_inverse=True)
+    cells = np.array([c.cell for c in obj.ctetra], dtype=np.int64)
+    labels, which = np.unique([c.region for c in obj.ctetra], return_inverse=True)
     votes = np.zeros((count, labels.shape[0]), dtype=np.int64)
     np.add.at(votes, (component[cells], which), 1)
     best = votes.argmax(axis=1)
@@ -648,7 +653,7 @@ def _majority_names(obj: GocadObject, component: NDArray[np.int64], count: int) 
 
 
 def _ctetra_codes(
-    obj: GocadObject, n_cells: int, error: Any
+    obj: GocadObject, n_cells: int, error: ErrorFactory
 ) -> tuple[NDArray[np.int64], list[str], list[tuple[int, str]]]:
     surfaces: list[str] = []
     position: dict[str, int] = {}
@@ -670,7 +675,7 @@ def _ctetra_codes(
     return codes, surfaces, regions
 
 
-def _first_crs(objects: list[GocadObject]) -> dict[str, Any] | None:
+def _first_crs(objects: list[GocadObject]) -> CrsBlock | None:
     for obj in objects:
         if obj.crs is not None:
             return obj.crs

@@ -13,6 +13,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.adapters.gocad.records import ErrorFactory
+
 __all__ = ["CellTable", "VertexTable"]
 
 IntArray = NDArray[np.int64]
@@ -34,7 +36,9 @@ class VertexTable:
 
     def __init__(self, n_values: int) -> None:
         self.n_values = n_values
-        self._chunks: list[tuple[IntArray, FloatArray, IntArray, FloatArray, Any, IntArray]] = []
+        self._chunks: list[
+            tuple[IntArray, FloatArray, IntArray, FloatArray, NDArray[np.int8], IntArray]
+        ] = []
         self._pending = _Pending()
 
     def add(
@@ -96,7 +100,7 @@ class VertexTable:
     def count(self) -> int:
         return int(sum(c[0].shape[0] for c in self._chunks)) + len(self._pending.ids)
 
-    def finish(self, error: Any) -> ResolvedVertices:
+    def finish(self, error: ErrorFactory) -> ResolvedVertices:
         """Resolve ATOM references; ``error(message, line)`` builds the FormatError to raise."""
         self._flush()
         if not self._chunks:
@@ -201,7 +205,9 @@ class IdLookup:
         found = self.sorted_ids[pos] == flat
         return self.order[pos].reshape(np.shape(ids)), found.reshape(np.shape(ids))
 
-    def require(self, ids: IntArray, lines: IntArray, keyword: str, error: Any) -> IntArray:
+    def require(
+        self, ids: IntArray, lines: IntArray, keyword: str, error: ErrorFactory
+    ) -> IntArray:
         """Indices of ``ids`` (rows of a cell table); FormatError naming the first unknown id."""
         index, found = self.find(ids)
         if not found.all():
@@ -279,7 +285,9 @@ class CellTable:
         )
 
 
-def check_finite_ids(error: Any, values: FloatArray, first_line: int, keyword: str) -> IntArray:
+def check_finite_ids(
+    error: ErrorFactory, values: FloatArray, first_line: int, keyword: str
+) -> IntArray:
     """Vertex ids read as floats in a bulk run → int64; FormatError when not integral."""
     column = values[:, 0]
     bad = np.flatnonzero(column != np.floor(column))

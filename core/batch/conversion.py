@@ -150,7 +150,7 @@ def convert_file(
     """
     started = time.perf_counter()
     try:
-        from geobrep.plugins import registries
+        from geobrep.host import registries
 
         scene = read(source, format=read_format)
         spec = registries().formats.choose_writer(target, write_format)
@@ -282,7 +282,7 @@ def _targets(
         raise FileAccessError(
             f"cannot create the output folder ({exc.strerror or exc})", out_dir
         ) from exc
-    from geobrep.plugins import registries
+    from geobrep.host import registries
 
     formats = registries().formats
     if to in formats:  # a format name: its first extension
@@ -334,7 +334,7 @@ def convert(
     targets = _targets(sources, None if output is None else Path(output), to, target_dir)
     write_format = None
     if to is not None:
-        from geobrep.plugins import registries
+        from geobrep.host import registries
 
         formats = registries().formats
         write_format = to if to in formats else None
@@ -442,7 +442,7 @@ def _run_dask(
 
 def demo_stage(ctx: Any) -> None:
     """Demo: a picture of the model, and the model converted to .vtu and .ply."""
-    from geobrep.plugins import registries
+    from geobrep.host import registries
 
     formats = registries().formats
     section: dict[str, Any] = {}

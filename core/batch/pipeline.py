@@ -265,11 +265,13 @@ class VoxelizeStep(StepOptions):
     name: str | None = None
 
     def builder_options(self) -> dict[str, Any]:
-        """The options of the ``voxelize`` builder."""
+        """The options of the ``voxelize`` voxelizer."""
         return self.model_dump(exclude_unset=True)
 
     def check(self, registries: Registries) -> None:
-        _get(registries.builders, "voxelize", "builder").validate_options(self.builder_options())
+        _get(registries.voxelizers, "voxelize", "voxelizer").validate_options(
+            self.builder_options()
+        )
 
 
 class WriteStep(StepOptions):
@@ -542,7 +544,7 @@ class Pipeline(BaseModel):
         Returns ``self``; raises :class:`OptionsError` naming the step, its kind and the option.
         """
         if registries is None:
-            from geobrep.plugins import registries as loaded
+            from geobrep.host import registries as loaded
 
             registries = loaded()
         for number, step in enumerate(self.step_list, 1):

@@ -52,7 +52,7 @@ from geobrep.errors import (
     OptionsError,
 )
 from geobrep.host.capabilities import format_losses
-from geobrep.model.entities import Entity, NurbsSurface, PointSet, PolyLine, Surface
+from geobrep.model.entities import Entity, LinearOctree, NurbsSurface, PointSet, PolyLine, Surface
 from geobrep.model.scene import Scene
 from geobrep.ops.io import read, write
 
@@ -207,7 +207,7 @@ def run_pipeline(
         OptionsError: the pipeline is invalid (a plugin or option is unknown), or has no inputs.
         FileAccessError: the output folder cannot be created.
     """
-    from geobrep.plugins import registries as loaded
+    from geobrep.host import registries as loaded
 
     if jobs < 1:
         raise OptionsError(f"jobs must be at least 1, got {jobs}")
@@ -286,7 +286,7 @@ def run_file(pipeline: Pipeline, source: Path, targets: tuple[Path, ...]) -> Pip
 
     ``targets`` are the files of the write steps, in order (see :func:`plan_outputs`).
     """
-    from geobrep.plugins import registries
+    from geobrep.host import registries
 
     started = time.perf_counter()
     reports: list[StepReport] = []
@@ -461,11 +461,11 @@ def _build(step: BuildBlocksStep, scene: Scene, work: _Work) -> Applied:
 
 
 def _voxelize(step: VoxelizeStep, scene: Scene, work: _Work) -> Applied:
-    spec = work.registries.builders.get("voxelize")
-    result = spec.function(scene, spec.validate_options(step.builder_options()))
-    if not isinstance(result, Scene) or not result.octrees:
-        raise GeobrepError(f"{spec.label} returned no octree")
-    octree = result.octrees[-1]
+    spec = work.registries.voxelizers.get("voxelize")
+    octree = spec.function(scene, spec.validate_options(step.builder_options()))
+    if not isinstance(octree, LinearOctree):
+        raise GeobrepError(f"{spec.label} returned {type(octree).__name__}, not a LinearOctree")
+    result = scene.with_entities(octree)
     return result, [f"octree: {octree.n_leaves} leaves, depth {octree.depth}"]
 
 

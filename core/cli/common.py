@@ -171,7 +171,7 @@ def format_name(action: Literal["read", "write"]) -> Callable[[str], str]:
     """The ``type=`` of an option naming a format (a registered name, or an extension)."""
 
     def check(text: str) -> str:
-        from geobrep.plugins import registries
+        from geobrep.host import registries
 
         formats = registries().formats
         able = [s for s in formats if (s.can_read if action == "read" else s.can_write)]

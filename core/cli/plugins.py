@@ -20,7 +20,7 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from geobrep.plugins import list_plugins
+    from geobrep.host import list_plugins
 
     infos = list_plugins()
     if args.json:

@@ -165,7 +165,7 @@ _ENTITY_ABBREVIATIONS = {
 def capability_table(formats: FormatRegistry) -> str:
     """The Markdown table of every registered format's capabilities (docs/formats.md).
 
-    >>> from geobrep.plugins import registries
+    >>> from geobrep.host import registries
     >>> capability_table(registries().formats).splitlines()[0].startswith("| format |")
     True
     """

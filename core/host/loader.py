@@ -59,6 +59,7 @@ HOOK_KINDS: dict[str, str] = {
     "geobrep_register_clippers": "clippers",
     "geobrep_register_fitters": "fitters",
     "geobrep_register_builders": "builders",
+    "geobrep_register_voxelizers": "voxelizers",
 }
 """Each hook and the :class:`~geobrep.host.registry.Registries` field it fills."""
 

@@ -49,6 +49,8 @@ __all__ = [
     "Registries",
     "Registry",
     "UnknownItemError",
+    "VoxelizerRegistry",
+    "VoxelizerSpec",
 ]
 
 SNIFF_BYTES = 4096
@@ -344,6 +346,23 @@ class BuilderSpec(RegisteredItem):
     input_types: tuple[str, ...] = ()
 
 
+class VoxelizerSpec(RegisteredItem):
+    """Turns closed bodies into a linear octree: ``function(scene, options) -> LinearOctree``.
+
+    ``scene`` holds the bodies to voxelize (its blocks, or closed surfaces when it has none);
+    ``options`` is an instance of ``options`` (a pydantic model) with at least ``depth``.
+    :func:`geobrep.voxelize` validates the options and calls it.
+
+    Example:
+        >>> VoxelizerSpec(name="octree", function=lambda scene, options: None).kind
+        'voxelizer'
+    """
+
+    kind: ClassVar[str] = "voxelizer"
+
+    function: Callable[..., Any]
+
+
 T = TypeVar("T", bound=RegisteredItem)
 
 
@@ -606,9 +625,15 @@ class BuilderRegistry(Registry[BuilderSpec]):
     item_type: ClassVar[type[RegisteredItem]] = BuilderSpec
 
 
+class VoxelizerRegistry(Registry[VoxelizerSpec]):
+    """Voxelizers: closed bodies to linear octrees."""
+
+    item_type: ClassVar[type[RegisteredItem]] = VoxelizerSpec
+
+
 @dataclass(frozen=True)
 class Registries:
-    """The four registries, one per hook kind.
+    """The registries, one per hook kind.
 
     Example:
         >>> Registries().formats
@@ -619,8 +644,9 @@ class Registries:
     clippers: ClipperRegistry = field(default_factory=ClipperRegistry)
     fitters: FitterRegistry = field(default_factory=FitterRegistry)
     builders: BuilderRegistry = field(default_factory=BuilderRegistry)
+    voxelizers: VoxelizerRegistry = field(default_factory=VoxelizerRegistry)
 
-    KINDS: ClassVar[tuple[str, ...]] = ("formats", "clippers", "fitters", "builders")
+    KINDS: ClassVar[tuple[str, ...]] = ("formats", "clippers", "fitters", "builders", "voxelizers")
 
     @classmethod
     def staging(cls, plugin: str) -> Registries:
@@ -630,6 +656,7 @@ class Registries:
             clippers=ClipperRegistry(plugin=plugin),
             fitters=FitterRegistry(plugin=plugin),
             builders=BuilderRegistry(plugin=plugin),
+            voxelizers=VoxelizerRegistry(plugin=plugin),
         )
 
     def by_kind(self) -> dict[str, Registry[Any]]:

@@ -36,7 +36,7 @@ def build_blocks(scene: Scene, builder: str = "blocks", **options: Any) -> Scene
     >>> len(built.blocks), built.metadata["block_report"]["direction_triangles"]
     (6, 132)
     """
-    from geobrep.plugins import registries
+    from geobrep.host import registries
 
     spec = registries().builders.get(builder)
     validated = spec.validate_options(options)

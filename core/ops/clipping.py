@@ -297,7 +297,7 @@ def as_plane(plane: Plane | Sequence[float] | Any) -> Plane:
 
 # ------------------------------------------------------------------------------- dispatch
 def _registry() -> ClipperRegistry:
-    from geobrep.plugins import registries
+    from geobrep.host import registries
 
     return registries().clippers
 

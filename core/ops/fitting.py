@@ -320,8 +320,8 @@ class FitResult:
         A format that cannot hold a NURBS surface gets the mesh of :meth:`tessellated` (its
         accuracy in ``report.written``); ``format`` and ``options`` are :func:`geobrep.write`'s.
         """
+        from geobrep.host import registries
         from geobrep.ops.io import write
-        from geobrep.plugins import registries
 
         target = Path(path)
         held = registries().formats.choose_writer(target, format).capabilities.entity_types
@@ -480,7 +480,7 @@ def fit(
     >>> result.report.passed, result.surface.type
     (True, 'NurbsSurface')
     """
-    from geobrep.plugins import registries
+    from geobrep.host import registries
 
     entity = _as_entity(points)
     spec = registries().fitters.get(method)

@@ -89,7 +89,7 @@ def read(path: PathArg, format: str | None = None, *, repair: bool = True, **opt
     :class:`FileAccessError` for a missing or unreadable file, :class:`UnknownFormatError` when
     no format matches, :class:`FormatError` (with path and line) when the content is wrong.
     """
-    from geobrep.plugins import registries
+    from geobrep.host import registries
 
     source = Path(path)
     _check_readable(source)
@@ -125,7 +125,7 @@ def write(
     The format comes from ``format`` or the extension. The file appears only when the writer
     succeeded: a failure leaves no partial output behind.
     """
-    from geobrep.plugins import registries
+    from geobrep.host import registries
 
     target = Path(path)
     scene = as_scene(data)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
-from geobrep.errors import OptionsError
+from geobrep.errors import GeobrepError, OptionsError
 from geobrep.model.entities import Block, Entity, LinearOctree, Surface
 from geobrep.model.scene import Scene
 
@@ -43,6 +43,7 @@ def voxelize(
     size: float | None = None,
     block_depth: int | None = None,
     name: str | None = None,
+    voxelizer: str = "voxelize",
 ) -> LinearOctree:
     """The linear octree (Morton codes and levels) of closed bodies.
 
@@ -60,6 +61,8 @@ def voxelize(
 
     The cube defaults to the bodies' bounding box grown to a cube from its minimum corner
     (``origin``, ``size`` override it); the finest cells are ``size / 2**depth`` wide.
+    ``voxelizer`` names the registered :class:`~geobrep.plugins.VoxelizerSpec` that does the
+    work (the built-in one is ``"voxelize"``).
 
     Example:
         >>> import geobrep
@@ -68,7 +71,7 @@ def voxelize(
         >>> tree.n_leaves > 0, sorted(set(tree.labels.tolist())) == [b.id for b in scene.blocks]
         (True, True)
     """
-    from geobrep.plugins import registries
+    from geobrep.host import registries
 
     if isinstance(obj, Block):
         raise OptionsError(
@@ -83,7 +86,7 @@ def voxelize(
         bodies = [int(scene.entities[0].id or 0)]  # this body, closed or not
     else:
         scene = Scene(entities=list(obj))
-    spec = registries().builders.get("voxelize")
+    spec = registries().voxelizers.get(voxelizer)
     options = spec.validate_options(
         depth=depth,
         method=method,
@@ -95,8 +98,10 @@ def voxelize(
         labels=labelled,
         name=name,
     )
-    result = spec.function(scene, options)
-    return result.octrees[-1]  # type: ignore[no-any-return]
+    octree = spec.function(scene, options)
+    if not isinstance(octree, LinearOctree):
+        raise GeobrepError(f"{spec.label} returned {type(octree).__name__}, not a LinearOctree")
+    return octree
 
 
 def _volume(body: dict[str, Any], key: str) -> float:

@@ -11,17 +11,17 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from geobrep.hookspecs import hookimpl
+from geobrep.plugins import hookimpl
 
 if TYPE_CHECKING:
-    from geobrep.host.registry import BuilderRegistry
+    from geobrep.plugins import BuilderRegistry
 
 __all__ = ["geobrep_register_builders"]
 
 
 @hookimpl
 def geobrep_register_builders(registry: BuilderRegistry) -> None:
-    from geobrep.host.registry import BuilderSpec
+    from geobrep.plugins import BuilderSpec
     from geobrep.plugins.blocks.builder import build_blocks
     from geobrep.plugins.blocks.options import BlockBuilderOptions
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.model.arcs import ArcChains, chain_arc_edges
+from geobrep.plugins import ArcChains, chain_arc_edges
 from geobrep.plugins.blocks.patches import PatchSplit
 
 __all__ = ["ArcChains", "chain_arcs"]

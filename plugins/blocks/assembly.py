@@ -15,9 +15,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.model.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
-from geobrep.model.scene import Group, Scene
-from geobrep.model.topology import Arc, Corner, Patch, Topology
+from geobrep import Arc, Block, Corner, Entity, Group, Patch, PatchSide, Scene, Surface, Topology
+from geobrep.plugins import UNIVERSE_KIND
 from geobrep.plugins.blocks.arcs import ArcChains
 from geobrep.plugins.blocks.measures import PatchMeasures
 from geobrep.plugins.blocks.patches import PatchSplit

@@ -18,9 +18,8 @@ from contextlib import contextmanager
 
 import numpy as np
 
+from geobrep import Scene, Surface
 from geobrep.errors import OptionsError, TopologyError
-from geobrep.model.entities import Surface
-from geobrep.model.scene import Scene
 from geobrep.plugins.blocks.arcs import ArcChains, chain_arcs
 from geobrep.plugins.blocks.assembly import assemble
 from geobrep.plugins.blocks.conformity import check_conformity

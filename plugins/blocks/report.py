@@ -6,8 +6,8 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from geobrep import Scene
 from geobrep.errors import TopologyError
-from geobrep.model.scene import Scene
 
 __all__ = ["REPORT_KEY", "BlockCheck", "BlockReport", "DanglingEntry", "block_report"]
 

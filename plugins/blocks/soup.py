@@ -14,10 +14,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import Surface
 from geobrep.errors import DegenerateGeometryError
 from geobrep.geometry import mesh
 from geobrep.geometry.bbox import column_extremes
-from geobrep.model.entities import Surface
 from geobrep.plugins.blocks.precision import Precision, data_tolerance, measure_precision
 
 __all__ = ["Soup", "build_soup"]

@@ -24,9 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import Block, Scene, Surface
 from geobrep.errors import TopologyError
-from geobrep.model.entities import Block, Surface
-from geobrep.model.scene import Scene
 from geobrep.plugins.blocks.csr import concatenated_ranges
 from geobrep.plugins.blocks.measures import PatchMeasures
 from geobrep.plugins.blocks.patches import PatchSplit

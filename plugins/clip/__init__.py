@@ -8,10 +8,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from geobrep.hookspecs import hookimpl
+from geobrep.plugins import hookimpl
 
 if TYPE_CHECKING:
-    from geobrep.host.registry import ClipperRegistry
+    from geobrep.plugins import ClipperRegistry
 
 __all__ = ["geobrep_register_clippers"]
 
@@ -19,7 +19,7 @@ __all__ = ["geobrep_register_clippers"]
 @hookimpl
 def geobrep_register_clippers(registry: ClipperRegistry) -> None:
     """Register the built-in clippers (modules are imported here, on first use of a registry)."""
-    from geobrep.host.registry import ClipperSpec
+    from geobrep.plugins import ClipperSpec
     from geobrep.plugins.clip.annotations import clip_annotation
     from geobrep.plugins.clip.blocks import clip_block, section_block
     from geobrep.plugins.clip.lines import clip_polyline, section_polyline

@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import Annotation, PolyLine
 from geobrep.geometry import Plane
-from geobrep.model.entities import Annotation, PolyLine
-from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
+from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.glyphs import ADVANCE, CAP_HEIGHT, DESCENDER, WIDTH, text_strokes
 from geobrep.plugins.clip.lines import cut_segments
 from geobrep.plugins.clip.options import AnnotationClipOptions, tolerance_of

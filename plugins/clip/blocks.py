@@ -18,11 +18,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import Block, Polygon, Scene, Surface
 from geobrep.errors import TopologyError
 from geobrep.geometry import Plane, boxes_plane_side, mesh
-from geobrep.model.entities import Block, Polygon, Surface
-from geobrep.model.scene import Scene
-from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
+from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.caps import cap_rings, cap_triangles, open_boundary
 from geobrep.plugins.clip.options import ClipOptions, tolerance_of
 from geobrep.plugins.clip.surfaces import surface_cut

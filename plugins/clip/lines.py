@@ -17,9 +17,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import PointSet, PolyLine
 from geobrep.geometry import Plane
-from geobrep.model.entities import PointSet, PolyLine
-from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
+from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.options import ClipOptions, tolerance_of
 from geobrep.plugins.clip.sides import (
     crossing_points,

@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from geobrep import NurbsSurface, Surface
 from geobrep.geometry import Plane
-from geobrep.model.entities import NurbsSurface, Surface
-from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
+from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.options import NurbsClipOptions, SurfaceClipOptions, tolerance_of
 from geobrep.plugins.clip.sides import vertex_sides
 from geobrep.plugins.clip.surfaces import clip_surface

@@ -16,11 +16,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import LinearOctree
 from geobrep.errors import DegenerateGeometryError
 from geobrep.geometry import Plane, boxes_plane_side
 from geobrep.geometry.morton import morton_decode
-from geobrep.model.entities import LinearOctree
-from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
+from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.options import OctreeClipOptions, tolerance_of
 
 __all__ = ["clip_octree", "leaf_boxes"]

@@ -6,7 +6,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from geobrep.ops.clipping import ClipContext
+from geobrep.plugins import ClipContext
 
 __all__ = [
     "AnnotationClipOptions",

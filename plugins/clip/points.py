@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
+from geobrep import PointSet
 from geobrep.geometry import Plane
-from geobrep.model.entities import PointSet
-from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
+from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.options import ClipOptions, tolerance_of
 from geobrep.plugins.clip.sides import vertex_sides
 

@@ -18,10 +18,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import Polygon, PolyLine
 from geobrep.errors import DegenerateGeometryError
 from geobrep.geometry import Plane
-from geobrep.model.entities import Polygon, PolyLine
-from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
+from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.caps import group_holes, loop_areas, plane_basis
 from geobrep.plugins.clip.lines import LineCut, cut_segments
 from geobrep.plugins.clip.options import ClipOptions, tolerance_of

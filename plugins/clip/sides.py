@@ -14,7 +14,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.model.properties import Property, PropertyMap
+from geobrep import Property
+from geobrep.plugins import PropertyMap
 
 __all__ = [
     "NEGATIVE_BIT",

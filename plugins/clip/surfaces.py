@@ -17,10 +17,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import Polygon, PolyLine, Property, Surface
 from geobrep.geometry import Plane, mesh
-from geobrep.model.entities import Polygon, PolyLine, Surface
-from geobrep.model.properties import Property, PropertyMap
-from geobrep.ops.clipping import ClipContext, Keep, halves, pack_halves
+from geobrep.plugins import ClipContext, Keep, PropertyMap, halves, pack_halves
 from geobrep.plugins.clip.caps import cap_rings, cap_triangles, open_boundary
 from geobrep.plugins.clip.loops import order_paths
 from geobrep.plugins.clip.options import SurfaceClipOptions, tolerance_of

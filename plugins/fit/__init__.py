@@ -15,8 +15,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from geobrep.hookspecs import hookimpl
-from geobrep.host.registry import FitterRegistry, FitterSpec
+from geobrep.plugins import FitterRegistry, FitterSpec, hookimpl
 from geobrep.plugins.fit.options import (
     ApproximationOptions,
     HybridOptions,

@@ -26,10 +26,10 @@ import numpy as np
 import scipy.linalg as la
 from numpy.typing import NDArray
 
+from geobrep import Entity, NurbsSurface, PointSet, PolyLine
 from geobrep.errors import DegenerateGeometryError, OptionsError
 from geobrep.geometry.nurbs import basis_matrix, greville_abscissae, surface_grid, surface_points
-from geobrep.model.entities import Entity, NurbsSurface, PointSet, PolyLine
-from geobrep.ops.fitting import FitResult
+from geobrep.plugins import FitResult
 from geobrep.plugins.fit.bending import bending_matrix
 from geobrep.plugins.fit.curves import BSplineCurve, Side
 from geobrep.plugins.fit.design import normal_equations, surface_design_matrix

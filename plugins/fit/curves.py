@@ -15,9 +15,9 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from geobrep import NurbsSurface
 from geobrep.errors import DegenerateGeometryError, OptionsError
 from geobrep.geometry.nurbs import basis_functions, basis_matrix, find_spans
-from geobrep.model.entities import NurbsSurface
 from geobrep.plugins.fit.knots import (
     averaged_knots,
     chord_parameters,

@@ -16,8 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import NurbsSurface, Surface
 from geobrep.geometry.distance import closest_points_on_triangles, mesh_distances
-from geobrep.model.entities import NurbsSurface, Surface
 from geobrep.plugins.fit.projection import project_points
 
 __all__ = ["closest_points_on_triangles", "mesh_distances", "surface_distances"]

@@ -24,10 +24,10 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
+from geobrep import Entity, NurbsSurface
 from geobrep.errors import DegenerateGeometryError, OptionsError
 from geobrep.geometry.nurbs import greville_abscissae, surface_points
-from geobrep.model.entities import Entity, NurbsSurface
-from geobrep.ops.fitting import FitResult
+from geobrep.plugins import FitResult
 from geobrep.plugins.fit.approximation import (
     NetFit,
     collect_points,
@@ -96,7 +96,7 @@ def layout_knots(
 def _core_mask(
     points: FloatArray, ab: FloatArray, options: HybridOptions, pointset: object
 ) -> NDArray[np.bool_]:
-    from geobrep.model.entities import PointSet
+    from geobrep import PointSet
 
     if options.core_property is not None:
         return core_by_property(

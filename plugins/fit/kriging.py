@@ -35,9 +35,9 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 from scipy.spatial.distance import cdist, pdist, squareform
 
+from geobrep import Entity, Surface
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.model.entities import Entity, Surface
-from geobrep.ops.fitting import FitResult
+from geobrep.plugins import FitResult
 from geobrep.plugins.fit.approximation import collect_points
 from geobrep.plugins.fit.distance import mesh_distances
 from geobrep.plugins.fit.lsq import single_threaded_blas

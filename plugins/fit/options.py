@@ -15,7 +15,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from geobrep.model.entities import NurbsSurface
+from geobrep import NurbsSurface
 
 __all__ = [
     "ApproximationOptions",

@@ -22,8 +22,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
+from geobrep import NurbsSurface
 from geobrep.geometry.nurbs import surface_derivatives, surface_grid, surface_points
-from geobrep.model.entities import NurbsSurface
 
 __all__ = ["SurfaceArgs", "initial_parameters", "invert_planar_map", "project_points"]
 

@@ -17,7 +17,7 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.ops.fitting import Deviation, FitReport, SubsetReport
+from geobrep.plugins import Deviation, FitReport, SubsetReport
 
 __all__ = ["accuracy_report", "sigma"]
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import Entity, NurbsSurface, PointSet, PolyLine
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.model.entities import Entity, NurbsSurface, PointSet, PolyLine
-from geobrep.ops.fitting import FitResult
+from geobrep.plugins import FitResult
 from geobrep.plugins.fit.distance import surface_distances
 from geobrep.plugins.fit.domain_map import check_fold_free
 from geobrep.plugins.fit.frame import LocalFrame

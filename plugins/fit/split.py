@@ -19,8 +19,8 @@ from numpy.typing import NDArray
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
+from geobrep import PointSet
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.model.entities import PointSet
 
 __all__ = ["core_by_density", "core_by_property", "inside_polygon", "otsu_threshold"]
 

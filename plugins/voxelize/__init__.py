@@ -1,38 +1,38 @@
-"""The linear-octree voxelizer plugin (builder ``voxelize``).
+"""The linear-octree voxelizer plugin (voxelizer ``voxelize``).
 
-Registers one builder, ``voxelize``: ``function(scene, options) -> Scene`` appends the
-:class:`~geobrep.LinearOctree` of the scene's closed bodies (blocks or closed surfaces) to the
-scene. Most callers use :func:`geobrep.voxelize`. Heavy work is imported on first use.
+Registers one voxelizer, ``voxelize``: ``function(scene, options) -> LinearOctree``, the
+octree of the scene's closed bodies (blocks or closed surfaces). Most callers use
+:func:`geobrep.voxelize`. Heavy work is imported on first use.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from geobrep.plugins import BuilderSpec, hookimpl
+from geobrep.plugins import VoxelizerSpec, hookimpl
 from geobrep.plugins.voxelize.options import VoxelizeOptions
 
 if TYPE_CHECKING:
-    from geobrep.host.registry import BuilderRegistry
-    from geobrep.model.scene import Scene
+    from geobrep import LinearOctree, Scene
+    from geobrep.plugins import VoxelizerRegistry
 
-__all__ = ["VoxelizeOptions", "geobrep_register_builders"]
+__all__ = ["VoxelizeOptions", "geobrep_register_voxelizers"]
 
 
-def _voxelize(scene: Scene, options: Any) -> Scene:
+def _voxelize(scene: Scene, options: Any) -> LinearOctree:
     from geobrep.plugins.voxelize.builder import voxelize_scene
 
-    return voxelize_scene(scene, options)
+    octree: LinearOctree = voxelize_scene(scene, options).octrees[-1]
+    return octree
 
 
 @hookimpl
-def geobrep_register_builders(registry: BuilderRegistry) -> None:
+def geobrep_register_voxelizers(registry: VoxelizerRegistry) -> None:
     registry.add(
-        BuilderSpec(
+        VoxelizerSpec(
             name="voxelize",
             description="Linear octree (Morton codes) of closed bodies: depth buffers or exact",
             function=_voxelize,
-            input_types=("Block", "Surface"),
             options=VoxelizeOptions,
         )
     )

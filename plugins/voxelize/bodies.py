@@ -7,11 +7,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import Block, Entity, Scene, Surface
 from geobrep.errors import DegenerateGeometryError, OptionsError, TopologyError
 from geobrep.geometry import mesh
 from geobrep.geometry.bbox import column_extremes
-from geobrep.model.entities import Block, Entity, Surface
-from geobrep.model.scene import Scene
 
 __all__ = ["Body", "OctreeCube", "collect_bodies", "octree_cube"]
 

@@ -17,13 +17,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep import LinearOctree, Scene, VoxelizationWarning
 from geobrep.errors import OptionsError
 from geobrep.geometry import mesh
 from geobrep.geometry.bbox import column_extremes
 from geobrep.geometry.morton import morton_decode
-from geobrep.model.entities import LinearOctree
-from geobrep.model.scene import Scene
-from geobrep.ops.voxelization import VoxelizationWarning
 from geobrep.plugins.voxelize.bodies import Body, collect_bodies, octree_cube
 from geobrep.plugins.voxelize.classify import OctantClassifier, PriorityClassifier
 from geobrep.plugins.voxelize.depth_buffers import DepthBufferClassifier, depth_buffers

@@ -55,7 +55,7 @@ def test_options_left_unindented_get_a_hint(tmp_path: Path) -> None:
          r"step 1 \(fit\): option 'method': unknown fitter 'krigging'; registered fitters: "
          r"approximation, hybrid, kriging, skinning"),
         ("voxelize: {depth: 30}",
-         r"step 1 \(voxelize\): builder 'voxelize': option 'depth': .*less than or equal to 12"),
+         r"step 1 \(voxelize\): voxelizer 'voxelize': option 'depth': .*less than or equal to 12"),
         ("build_blocks: {options: {tolerence: 0.1}}",
          r"step 1 \(build_blocks\): builder 'blocks': option 'tolerence': unknown option"),
         ("build: {builder: nope}", r"step 1 \(build\): option 'builder': unknown builder 'nope'"),

@@ -93,6 +93,7 @@ def test_good_plugins_load_and_bad_ones_fail_alone(fake_entry_points: SetEntryPo
         "clippers": ("fakegood.points",),
         "fitters": (),
         "builders": (),
+        "voxelizers": (),
     }
     failed = {name for name, info in plugins.items() if info.status == "failed"}
     assert failed == set(plugins) - {"good"}

@@ -107,12 +107,12 @@ def test_single_surface_has_no_labels() -> None:
     assert vb.body_report(tree)["octree_volume"] == tree.volume
 
 
-def test_builder_is_registered(layer_cake: Scene) -> None:
-    spec = geobrep.plugins.registries().builders.get("voxelize")
+def test_voxelizer_is_registered(layer_cake: Scene) -> None:
+    spec = geobrep.plugins.registries().voxelizers.get("voxelize")
     assert spec.plugin == "voxelize"
-    result = spec.function(layer_cake, spec.validate_options(depth=3))
-    assert len(result.entities) == len(layer_cake.entities) + 1
-    assert isinstance(result.entities[-1], LinearOctree)
+    octree = spec.function(layer_cake, spec.validate_options(depth=3))
+    assert isinstance(octree, LinearOctree)
+    assert "voxelize" not in geobrep.plugins.registries().builders
 
 
 def test_errors(layer_cake: Scene) -> None:

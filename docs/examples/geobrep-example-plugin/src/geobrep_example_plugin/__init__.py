@@ -14,7 +14,7 @@ from geobrep.plugins import FormatCapabilities, FormatSpec, hookimpl
 from geobrep_example_plugin.xyz import XyzOptions, looks_like_xyz, read_xyz, write_xyz
 
 if TYPE_CHECKING:
-    from geobrep.host.registry import FormatRegistry
+    from geobrep.plugins import FormatRegistry
 
 __all__ = ["XyzOptions", "geobrep_register_formats", "looks_like_xyz", "read_xyz", "write_xyz"]
 

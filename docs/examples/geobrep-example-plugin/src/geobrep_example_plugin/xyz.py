@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from geobrep.errors import FileAccessError, FormatError
+from geobrep.plugins import FileAccessError, FormatError
 
 if TYPE_CHECKING:
     from geobrep import Scene
@@ -137,7 +137,7 @@ def write_xyz(scene: Scene, path: Path, options: XyzOptions) -> None:
     point-data properties are not stored by this format.
     """
     from geobrep import PointSet
-    from geobrep.ops.io import atomic_write
+    from geobrep.plugins import atomic_write
 
     entities = tuple(scene.entities)
     point_sets = [entity for entity in entities if isinstance(entity, PointSet)]
