@@ -9,17 +9,23 @@ A4.3-A4.4), rewritten for arrays of parameters.
 >>> spans = find_spans(2, knots, np.array([0.25, 1.0]))
 >>> basis_functions(2, knots, spans, np.array([0.25, 1.0])).round(4).tolist()
 [[0.25, 0.625, 0.125], [0.0, 0.0, 1.0]]
+
+The surface evaluators take a :class:`NurbsNet`: degrees, knot vectors, control net and weights
+checked once and carried together.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
 from math import comb
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from geobrep.errors import EntityValidationError
+
 __all__ = [
-    "SurfaceArgs",
+    "NurbsNet",
     "Tessellation",
     "basis_derivatives",
     "basis_functions",
@@ -34,11 +40,123 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
-#: What the surface evaluators take first: degrees, knots, control net, weights (or None).
-SurfaceArgs = tuple[int, int, FloatArray, FloatArray, FloatArray, FloatArray | None]
 
 #: Points evaluated per block, so that gathered control points stay within a few tens of MB.
 _BLOCK = 1 << 15
+
+
+@dataclass(frozen=True, eq=False)
+class NurbsNet:
+    """A tensor-product NURBS net: what the surface evaluators take, validated once.
+
+    ``control_points`` is ``(nu, nv, c)``: ``c = 3`` coordinates for a surface (a non-rational
+    net may carry any number of channels for :func:`surface_points`, e.g. heights or a planar
+    map); ``weights`` is ``(nu, nv)`` and positive, or ``None`` for a B-spline net; the knot
+    vectors hold ``nu + degree_u + 1`` and ``nv + degree_v + 1`` non-decreasing values.
+
+    >>> k = np.array([0.0, 0.0, 1.0, 1.0])
+    >>> plate = NurbsNet(1, 1, k, k, np.zeros((2, 2, 3)))
+    >>> plate.shape, plate.domain, plate.is_rational
+    ((2, 2), ((0.0, 1.0), (0.0, 1.0)), False)
+    >>> NurbsNet(1, 1, k[1:], k, np.zeros((2, 2, 3)))
+    Traceback (most recent call last):
+    ...
+    geobrep.errors.EntityValidationError: NurbsNet: knots_u: has 3 values; ... need 4
+    """
+
+    degree_u: int
+    degree_v: int
+    knots_u: FloatArray
+    knots_v: FloatArray
+    control_points: FloatArray
+    weights: FloatArray | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("knots_u", "knots_v", "control_points", "weights"):
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, np.asarray(value, dtype=np.float64))
+        net = self.control_points
+        if net.ndim != 3 or net.shape[2] < 1:
+            raise EntityValidationError(
+                "NurbsNet", "control_points", f"expected shape (nu, nv, c), got {net.shape}"
+            )
+        for axis, degree, count, knots in (
+            ("u", self.degree_u, net.shape[0], self.knots_u),
+            ("v", self.degree_v, net.shape[1], self.knots_v),
+        ):
+            _check_knots(axis, degree, count, knots)
+        if self.weights is not None:
+            if self.weights.shape != net.shape[:2]:
+                raise EntityValidationError(
+                    "NurbsNet",
+                    "weights",
+                    f"shape {self.weights.shape} does not match the net {net.shape[:2]}",
+                )
+            if self.weights.size and not bool(self.weights.min() > 0):
+                raise EntityValidationError("NurbsNet", "weights", "must be positive")
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """Control-net size ``(nu, nv)``."""
+        return int(self.control_points.shape[0]), int(self.control_points.shape[1])
+
+    @property
+    def channels(self) -> int:
+        """Values per control point (3 for a surface)."""
+        return int(self.control_points.shape[2])
+
+    @property
+    def is_rational(self) -> bool:
+        """Whether the weights differ (equal weights evaluate as a B-spline net)."""
+        w = self.weights
+        return w is not None and w.size > 0 and not bool(np.all(w == w.flat[0]))
+
+    @property
+    def domain(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """Parameter domain ``((u_min, u_max), (v_min, v_max))``."""
+        nu, nv = self.shape
+        return (
+            (float(self.knots_u[self.degree_u]), float(self.knots_u[nu])),
+            (float(self.knots_v[self.degree_v]), float(self.knots_v[nv])),
+        )
+
+    @property
+    def centre(self) -> FloatArray:
+        """Centre of the control net's bounding box (evaluate about it: UTM-scale precision)."""
+        flat = self.control_points.reshape(-1, self.channels)
+        return np.asarray(0.5 * (flat.min(axis=0) + flat.max(axis=0)), dtype=np.float64)
+
+    def with_control_points(self, control_points: ArrayLike) -> NurbsNet:
+        """The same degrees, knots and weights with another control net (of the same size)."""
+        return replace(self, control_points=np.asarray(control_points, dtype=np.float64))
+
+    def _homogeneous(self) -> tuple[FloatArray, bool]:
+        """The net to contract: ``[w x, w y, w z, w]`` when rational, else the plain net."""
+        if not self.is_rational:
+            return self.control_points, False
+        assert self.weights is not None
+        w = self.weights[..., None]
+        return np.concatenate([self.control_points * w, w], axis=-1), True
+
+
+def _check_knots(axis: str, degree: int, count: int, knots: FloatArray) -> None:
+    """Raise unless ``knots`` is a non-decreasing vector for ``count`` control points."""
+    if degree < 0:
+        raise EntityValidationError("NurbsNet", f"degree_{axis}", f"must be >= 0, got {degree}")
+    if count < degree + 1:
+        raise EntityValidationError(
+            "NurbsNet", "control_points", f"{count} rows along {axis} need degree <= {count - 1}"
+        )
+    if knots.ndim != 1 or knots.shape[0] != count + degree + 1:
+        raise EntityValidationError(
+            "NurbsNet",
+            f"knots_{axis}",
+            f"has {knots.shape[0] if knots.ndim == 1 else knots.shape} values; {count} control "
+            f"points of degree {degree} need {count + degree + 1}",
+        )
+    if np.any(np.diff(knots) < 0):
+        raise EntityValidationError("NurbsNet", f"knots_{axis}", "must be non-decreasing")
 
 
 def find_spans(degree: int, knots: FloatArray, params: ArrayLike) -> IntArray:
@@ -162,27 +280,7 @@ def greville_abscissae(degree: int, knots: FloatArray) -> FloatArray:
     return np.asarray(windows[:n_ctrl].mean(axis=1), dtype=np.float64)
 
 
-def _homogeneous(control_points: FloatArray, weights: FloatArray | None) -> FloatArray:
-    """``(nu, nv, 4)`` weighted control points ``[w x, w y, w z, w]``, or the plain net."""
-    if weights is None:
-        return control_points
-    return np.concatenate([control_points * weights[..., None], weights[..., None]], axis=-1)
-
-
-def _rational(weights: FloatArray | None) -> bool:
-    return weights is not None and not bool(np.all(weights == weights.flat[0]))
-
-
-def surface_points(
-    degree_u: int,
-    degree_v: int,
-    knots_u: FloatArray,
-    knots_v: FloatArray,
-    control_points: FloatArray,
-    weights: FloatArray | None,
-    u: ArrayLike,
-    v: ArrayLike,
-) -> FloatArray:
+def surface_points(net: NurbsNet, u: ArrayLike, v: ArrayLike) -> FloatArray:
     """Surface points at parameter pairs ``(u[i], v[i])``: shape ``(m, 3)`` (A3.5/A4.3).
 
     A non-rational net may have any number of channels ``(nu, nv, c)``; the result is ``(m, c)``.
@@ -190,14 +288,14 @@ def surface_points(
     >>> import numpy as np
     >>> net = np.zeros((2, 2, 3)); net[1, :, 0] = 1.0; net[:, 1, 1] = 1.0
     >>> k = np.array([0.0, 0.0, 1.0, 1.0])
-    >>> surface_points(1, 1, k, k, net, None, [0.25], [0.5]).tolist()
+    >>> surface_points(NurbsNet(1, 1, k, k, net), [0.25], [0.5]).tolist()
     [[0.25, 0.5, 0.0]]
     """
     uu = np.asarray(u, dtype=np.float64).reshape(-1)
     vv = np.asarray(v, dtype=np.float64).reshape(-1)
-    rational = _rational(weights)
-    net = _homogeneous(control_points, weights if rational else None)
-    channels = net.shape[-1] - (1 if rational else 0)
+    degree_u, degree_v, knots_u, knots_v = net.degree_u, net.degree_v, net.knots_u, net.knots_v
+    points, rational = net._homogeneous()
+    channels = points.shape[-1] - (1 if rational else 0)
     out = np.empty((uu.shape[0], channels))
     ar_u = np.arange(degree_u + 1)
     ar_v = np.arange(degree_v + 1)
@@ -211,32 +309,22 @@ def surface_points(
         nv = basis_functions(degree_v, knots_v, sv, bv)
         iu = (su[:, None] - degree_u + ar_u)[:, :, None]
         iv = (sv[:, None] - degree_v + ar_v)[:, None, :]
-        gathered = net[iu, iv].reshape(m, width, net.shape[-1])  # (m, (p+1)(q+1), c)
+        gathered = points[iu, iv].reshape(m, width, points.shape[-1])  # (m, (p+1)(q+1), c)
         products = (nu[:, :, None] * nv[:, None, :]).reshape(m, width)
         values = np.einsum("mi,mik->mk", products, gathered)
         out[start : start + _BLOCK] = values[:, :-1] / values[:, -1:] if rational else values
     return out
 
 
-def surface_derivatives(
-    degree_u: int,
-    degree_v: int,
-    knots_u: FloatArray,
-    knots_v: FloatArray,
-    control_points: FloatArray,
-    weights: FloatArray | None,
-    u: ArrayLike,
-    v: ArrayLike,
-    order: int = 1,
-) -> FloatArray:
+def surface_derivatives(net: NurbsNet, u: ArrayLike, v: ArrayLike, order: int = 1) -> FloatArray:
     """Partial derivatives ``SKL[:, k, l] = ∂^(k+l) S / ∂u^k ∂v^l`` for ``k + l <= order``.
 
     Shape ``(m, order + 1, order + 1, 3)``; entries with ``k + l > order`` are zero (A3.6/A4.4).
     """
     uu = np.asarray(u, dtype=np.float64).reshape(-1)
     vv = np.asarray(v, dtype=np.float64).reshape(-1)
-    rational = _rational(weights)
-    net = _homogeneous(control_points, weights if rational else None)
+    degree_u, degree_v, knots_u, knots_v = net.degree_u, net.degree_v, net.knots_u, net.knots_v
+    points, rational = net._homogeneous()
     m = uu.shape[0]
     du, dv = min(order, degree_u), min(order, degree_v)
     out = np.zeros((m, order + 1, order + 1, 3))
@@ -251,7 +339,7 @@ def surface_derivatives(
         nv = basis_derivatives(degree_v, knots_v, sv, bv, dv)
         iu = (su[:, None] - degree_u + ar_u)[:, :, None]
         iv = (sv[:, None] - degree_v + ar_v)[:, None, :]
-        gathered = net[iu, iv]
+        gathered = points[iu, iv]
         # homogeneous derivatives A[k, l] (with the weight as the last channel when rational)
         hom = np.einsum("mki,mlj,mijc->mklc", nu, nv, gathered)
         block = np.zeros((bu.shape[0], order + 1, order + 1, 3))
@@ -282,16 +370,7 @@ def surface_derivatives(
     return out
 
 
-def surface_grid(
-    degree_u: int,
-    degree_v: int,
-    knots_u: FloatArray,
-    knots_v: FloatArray,
-    control_points: FloatArray,
-    weights: FloatArray | None,
-    u: ArrayLike,
-    v: ArrayLike,
-) -> FloatArray:
+def surface_grid(net: NurbsNet, u: ArrayLike, v: ArrayLike) -> FloatArray:
     """Surface points on the tensor grid ``u × v``: shape ``(len(u), len(v), 3)``.
 
     Evaluated in two passes (first along u, then along v), so the cost is
@@ -299,15 +378,15 @@ def surface_grid(
     """
     uu = np.asarray(u, dtype=np.float64).reshape(-1)
     vv = np.asarray(v, dtype=np.float64).reshape(-1)
-    rational = _rational(weights)
-    net = _homogeneous(control_points, weights if rational else None)
+    degree_u, degree_v, knots_u, knots_v = net.degree_u, net.degree_v, net.knots_u, net.knots_v
+    points, rational = net._homogeneous()
     su = find_spans(degree_u, knots_u, uu)
     sv = find_spans(degree_v, knots_v, vv)
     nu = basis_functions(degree_u, knots_u, su, uu)
     nv = basis_functions(degree_v, knots_v, sv, vv)
     iu = su[:, None] - degree_u + np.arange(degree_u + 1)
     iv = sv[:, None] - degree_v + np.arange(degree_v + 1)
-    along_u = np.einsum("ai,aijc->ajc", nu, net[iu])  # (mu, nv, c)
+    along_u = np.einsum("ai,aijc->ajc", nu, points[iu])  # (mu, nv, c)
     out = np.empty((uu.shape[0], vv.shape[0], 3))
     rows = max(1, _BLOCK // max(1, vv.shape[0]))
     for start in range(0, uu.shape[0], rows):
@@ -360,13 +439,13 @@ def _span_samples(degree: int, knots: FloatArray, density: float) -> FloatArray:
     return np.concatenate([starts + fractions * np.repeat(lengths, parts), breaks[-1:]])
 
 
-def _midpoint_deviation(args: SurfaceArgs, u: FloatArray, v: FloatArray, grid: FloatArray) -> float:
+def _midpoint_deviation(net: NurbsNet, u: FloatArray, v: FloatArray, grid: FloatArray) -> float:
     """Largest distance between the surface and the mesh at cell centres and edge midpoints."""
     um, vm = 0.5 * (u[:-1] + u[1:]), 0.5 * (v[:-1] + v[1:])
-    centre = surface_grid(*args, um, vm)
+    centre = surface_grid(net, um, vm)
     mesh_centre = 0.5 * (grid[:-1, :-1] + grid[1:, 1:])  # midpoint of each cell's diagonal
-    along_u = surface_grid(*args, um, v)
-    along_v = surface_grid(*args, u, vm)
+    along_u = surface_grid(net, um, v)
+    along_v = surface_grid(net, u, vm)
     errors = (
         np.linalg.norm(centre - mesh_centre, axis=-1).max(initial=0.0),
         np.linalg.norm(along_u - 0.5 * (grid[:-1] + grid[1:]), axis=-1).max(initial=0.0),
@@ -376,12 +455,7 @@ def _midpoint_deviation(args: SurfaceArgs, u: FloatArray, v: FloatArray, grid: F
 
 
 def tessellate(
-    degree_u: int,
-    degree_v: int,
-    knots_u: FloatArray,
-    knots_v: FloatArray,
-    control_points: FloatArray,
-    weights: FloatArray | None,
+    net: NurbsNet,
     resolution: int | tuple[int, int] | None = None,
     tolerance: float | None = None,
     max_vertices: int = 4_000_000,
@@ -394,18 +468,16 @@ def tessellate(
     at cell centres and edge midpoints (capped at ``max_vertices``). With neither, every knot
     span is split into 4 on average.
     """
-    args: SurfaceArgs = (degree_u, degree_v, knots_u, knots_v, control_points, weights)
-    nu_ctrl = knots_u.shape[0] - degree_u - 1
-    nv_ctrl = knots_v.shape[0] - degree_v - 1
-    domain_u = (float(knots_u[degree_u]), float(knots_u[nu_ctrl]))
-    domain_v = (float(knots_v[degree_v]), float(knots_v[nv_ctrl]))
+    degree_u, degree_v, knots_u, knots_v = net.degree_u, net.degree_v, net.knots_u, net.knots_v
+    nu_ctrl, nv_ctrl = net.shape
+    domain_u, domain_v = net.domain
     if resolution is not None:
         ru, rv = (resolution, resolution) if isinstance(resolution, int) else resolution
         if ru < 2 or rv < 2:
             raise ValueError(f"resolution must be at least 2 per direction, got {resolution}")
         u = np.linspace(*domain_u, ru)
         v = np.linspace(*domain_v, rv)
-        grid = surface_grid(*args, u, v)
+        grid = surface_grid(net, u, v)
     else:
         # samples per whole parameter range; every knot span gets at least one
         spans_u = np.unique(knots_u[degree_u : nu_ctrl + 1]).shape[0] - 1
@@ -414,10 +486,10 @@ def tessellate(
         while True:
             u = _span_samples(degree_u, knots_u, density_u)
             v = _span_samples(degree_v, knots_v, density_v)
-            grid = surface_grid(*args, u, v)
+            grid = surface_grid(net, u, v)
             if tolerance is None:
                 break
-            deviation = _midpoint_deviation(args, u, v, grid)
+            deviation = _midpoint_deviation(net, u, v, grid)
             if deviation <= tolerance:
                 break
             # the chordal deviation of a smooth surface falls with the square of the step
@@ -427,6 +499,6 @@ def tessellate(
             ) > max_vertices:
                 break
             density_u, density_v = density_u * factor, density_v * factor
-    deviation = _midpoint_deviation(args, u, v, grid)
+    deviation = _midpoint_deviation(net, u, v, grid)
     faces = _grid_faces(u.shape[0], v.shape[0])
     return Tessellation(grid.reshape(-1, 3), faces, u, v, deviation)

@@ -28,13 +28,19 @@ from numpy.typing import NDArray
 
 from geobrep import Entity, NurbsSurface, PointSet, PolyLine
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.geometry.nurbs import basis_matrix, greville_abscissae, surface_grid, surface_points
+from geobrep.geometry.nurbs import (
+    NurbsNet,
+    basis_matrix,
+    greville_abscissae,
+    surface_grid,
+    surface_points,
+)
 from geobrep.plugins import FitResult
 from geobrep.plugins.fit.bending import bending_matrix
 from geobrep.plugins.fit.curves import BSplineCurve, Side
 from geobrep.plugins.fit.design import normal_equations, surface_design_matrix
 from geobrep.plugins.fit.distance import surface_distances
-from geobrep.plugins.fit.domain_map import check_fold_free, fill_net
+from geobrep.plugins.fit.domain_map import check_fold_free, fill_net, planar_map
 from geobrep.plugins.fit.frame import LocalFrame
 from geobrep.plugins.fit.knots import approximation_knots, merge_knots, uniform_knots
 from geobrep.plugins.fit.lsq import single_threaded_blas, solve_penalised
@@ -61,11 +67,7 @@ _ALONG_V: tuple[Side, ...] = ("u0", "u1")  # curves on these sides run along v
 class NetFit:
     """A fitted net in local coordinates with the data parameters and residuals."""
 
-    degree_u: int
-    degree_v: int
-    knots_u: FloatArray
-    knots_v: FloatArray
-    net: FloatArray
+    net: NurbsNet
     u: FloatArray
     v: FloatArray
     residuals: FloatArray
@@ -327,9 +329,9 @@ def _plane_fit(
         notes: list[str] = []
         if constraints:
             planar = _planar_net(constraints, (ku, kv), (p, q), (a0, a1, b0, b1))
-            check_fold_free(p, q, ku, kv, planar, "fitter 'approximation'")
-            args = (p, q, ku, kv, np.concatenate([planar, np.zeros((nu, nv, 1))], axis=2), None)
-            u, v, off = invert_planar_map(args, ab)
+            in_plane = planar_map((p, q), (ku, kv), planar)
+            check_fold_free(in_plane, "fitter 'approximation'")
+            u, v, off = invert_planar_map(in_plane, ab)
             outside = int(np.count_nonzero(off > 1e-6 * extent))
             if outside:
                 notes.append(
@@ -354,19 +356,13 @@ def _plane_fit(
             fixed=fixed,
             fixed_values=fixed_h,
         )
-        net = np.concatenate([planar, heights], axis=2)
+        net = NurbsNet(p, q, ku, kv, np.concatenate([planar, heights], axis=2))
         if constraints:
-            fitted_points = surface_points(p, q, ku, kv, net, None, u, v)
-            residuals = np.linalg.norm(fitted_points - local, axis=1)
+            residuals = np.linalg.norm(surface_points(net, u, v) - local, axis=1)
         else:  # the planar map is exactly affine: only the heights differ
-            residuals = np.abs(
-                surface_points(p, q, ku, kv, heights, None, u, v)[:, 0] - local[:, 2]
-            )
+            on_heights = surface_points(net.with_control_points(heights), u, v)
+            residuals = np.abs(on_heights[:, 0] - local[:, 2])
         best = NetFit(
-            p,
-            q,
-            ku,
-            kv,
             net,
             u,
             v,
@@ -380,17 +376,10 @@ def _plane_fit(
     return best
 
 
-def _surface_lengths(args: tuple[object, ...]) -> tuple[float, float]:
+def _surface_lengths(net: NurbsNet) -> tuple[float, float]:
     """Mean lengths of the iso-curves of a surface along u and along v (for energy scaling)."""
-    p, q, ku, kv, net, _ = args
-    assert isinstance(ku, np.ndarray)
-    assert isinstance(kv, np.ndarray)
-    assert isinstance(net, np.ndarray)
-    assert isinstance(p, int)
-    assert isinstance(q, int)
-    u = np.linspace(ku[p], ku[net.shape[0]], 24)
-    v = np.linspace(kv[q], kv[net.shape[1]], 24)
-    grid = surface_grid(p, q, ku, kv, net, args[5], u, v)  # type: ignore[arg-type]
+    (umin, umax), (vmin, vmax) = net.domain
+    grid = surface_grid(net, np.linspace(umin, umax, 24), np.linspace(vmin, vmax, 24))
     along_u = np.linalg.norm(np.diff(grid, axis=0), axis=2).sum(axis=0).mean()
     along_v = np.linalg.norm(np.diff(grid, axis=1), axis=2).sum(axis=1).mean()
     return float(along_u), float(along_v)
@@ -402,22 +391,14 @@ def _base_surface_fit(
     base = options.base_surface
     assert base is not None
     p, q = options.degree_u, options.degree_v
-    weights = np.asarray(base.weights) if base.is_rational else None
-    base_args = (
-        base.degree_u,
-        base.degree_v,
-        np.asarray(base.knots_u),
-        np.asarray(base.knots_v),
-        frame.to_local(np.asarray(base.control_points).reshape(-1, 3)).reshape(
-            base.control_points.shape
-        ),
-        weights,
-    )
+    shape = base.control_points.shape
+    world = np.asarray(base.control_points).reshape(-1, 3)
+    base_net = base.net.with_control_points(frame.to_local(world).reshape(shape))
     (umin, umax), (vmin, vmax) = base.domain
-    u_raw, v_raw, _ = project_points(base_args, local)
+    u_raw, v_raw, _ = project_points(base_net, local)
     u = (u_raw - umin) / (umax - umin)
     v = (v_raw - vmin) / (vmax - vmin)
-    width, height = _surface_lengths(base_args)
+    width, height = _surface_lengths(base_net)
     constraints = _constraints(options, frame, extent)
     along_u = [c.curve.knots for c in constraints if c.side not in _ALONG_V]
     along_v = [c.curve.knots for c in constraints if c.side in _ALONG_V]
@@ -430,7 +411,7 @@ def _base_surface_fit(
         kv = _inner_knots(q, spans_v, along_v)
         nu, nv = ku.shape[0] - p - 1, kv.shape[0] - q - 1
         fixed, fixed_xyz = _boundary_rows(constraints, ku, kv, nu, nv, 3)
-        net = solve_net(
+        control = solve_net(
             (p, q),
             (ku, kv),
             u,
@@ -441,12 +422,9 @@ def _base_surface_fit(
             fixed=fixed if constraints else None,
             fixed_values=fixed_xyz if constraints else None,
         )
-        residuals = np.linalg.norm(surface_points(p, q, ku, kv, net, None, u, v) - local, axis=1)
+        net = NurbsNet(p, q, ku, kv, control)
+        residuals = np.linalg.norm(surface_points(net, u, v) - local, axis=1)
         best = NetFit(
-            p,
-            q,
-            ku,
-            kv,
             net,
             u,
             v,
@@ -529,11 +507,7 @@ def _grid_fit(local: FloatArray, options: ApproximationOptions) -> NetFit:
         fitted = np.matmul(a_v[None, :, :], on_rows).reshape(-1, 3)
         residuals = np.linalg.norm(fitted - local, axis=1)
         best = NetFit(
-            p,
-            q,
-            ku,
-            kv,
-            np.ascontiguousarray(net),
+            NurbsNet(p, q, ku, kv, np.ascontiguousarray(net)),
             u,
             v,
             residuals,
@@ -581,7 +555,7 @@ def approximate_points(
 
 def unmet_note(epsilon: float, achieved: float, fitted: NetFit, n_points: int) -> str:
     """What the report says when the finest admissible net still misses ε."""
-    nu, nv = fitted.net.shape[:2]
+    nu, nv = fitted.net.shape
     return (
         f"ε = {epsilon:g} cannot be met: σ = {achieved:.4g} with the finest net the data support "
         f"({nu} × {nv} control points for {n_points} points; a finer net would fit noise): the "
@@ -593,13 +567,14 @@ def nurbs_from_local(
     fitted: NetFit, frame: LocalFrame, name: str, kind: str | None
 ) -> NurbsSurface:
     """The fitted net as a world-coordinate NurbsSurface."""
-    nu, nv = fitted.net.shape[:2]
-    world = frame.to_world(fitted.net.reshape(-1, 3)).reshape(nu, nv, 3)
+    net = fitted.net
+    nu, nv = net.shape
+    world = frame.to_world(net.control_points.reshape(-1, 3)).reshape(nu, nv, 3)
     return NurbsSurface(
-        degree_u=fitted.degree_u,
-        degree_v=fitted.degree_v,
-        knots_u=fitted.knots_u,
-        knots_v=fitted.knots_v,
+        degree_u=net.degree_u,
+        degree_v=net.degree_v,
+        knots_u=net.knots_u,
+        knots_v=net.knots_v,
         control_points=world,
         weights=np.ones((nu, nv)),
         name=name,

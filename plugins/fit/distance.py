@@ -39,16 +39,8 @@ def surface_distances(
     pts = np.asarray(points, dtype=np.float64)
     if isinstance(surface, Surface):
         return mesh_distances(surface, pts)
-    net = np.asarray(surface.control_points)
-    centre = 0.5 * (net.reshape(-1, 3).min(axis=0) + net.reshape(-1, 3).max(axis=0))
-    weights = np.asarray(surface.weights) if surface.is_rational else None
-    args = (
-        surface.degree_u,
-        surface.degree_v,
-        np.asarray(surface.knots_u),
-        np.asarray(surface.knots_v),
-        net - centre,
-        weights,
-    )
-    _, _, distances = project_points(args, pts - centre, u0, v0)
+    net = surface.net
+    centre = net.centre
+    centred = net.with_control_points(net.control_points - centre)
+    _, _, distances = project_points(centred, pts - centre, u0, v0)
     return distances

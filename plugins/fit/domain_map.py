@@ -25,10 +25,10 @@ import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from geobrep.errors import DegenerateGeometryError
-from geobrep.geometry.nurbs import surface_derivatives
+from geobrep.geometry.nurbs import NurbsNet, surface_derivatives
 from geobrep.plugins.fit.bending import laplacian_matrix
 
-__all__ = ["check_fold_free", "fill_net", "piecewise_linear"]
+__all__ = ["check_fold_free", "fill_net", "piecewise_linear", "planar_map"]
 
 FloatArray = NDArray[np.float64]
 
@@ -67,30 +67,38 @@ def piecewise_linear(g: FloatArray, breaks: FloatArray, positions: FloatArray) -
     )
 
 
+def planar_map(
+    degrees: tuple[int, int], knots: tuple[FloatArray, FloatArray], planar: FloatArray
+) -> NurbsNet:
+    """The in-plane net ``planar (nu, nv, 2)`` as a net of three channels (zero heights)."""
+    lifted = np.concatenate([planar, np.zeros((*planar.shape[:2], 1))], axis=2)
+    return NurbsNet(degrees[0], degrees[1], knots[0], knots[1], lifted)
+
+
 def check_fold_free(
-    degree_u: int,
-    degree_v: int,
-    knots_u: FloatArray,
-    knots_v: FloatArray,
-    net_ab: FloatArray,
+    net: NurbsNet,
     label: str,
     per_span: int = 3,
     skip: tuple[tuple[float, float], tuple[float, float]] | None = None,
 ) -> None:
-    """Raise if the planar map folds over (its Jacobian changes sign) anywhere on a sample grid.
+    """Raise if the planar map (the first two channels of ``net``) folds over anywhere.
 
-    ``skip = ((u0, u1), (v0, v1))`` leaves out a parameter box (a patch that is never inverted).
+    The map's Jacobian must keep its sign on a sample grid of every knot span; ``skip =
+    ((u0, u1), (v0, v1))`` leaves out a parameter box (a patch that is never inverted).
     """
-    net = np.concatenate([net_ab, np.zeros((*net_ab.shape[:2], 1))], axis=2)
+    planar = planar_map(
+        (net.degree_u, net.degree_v), (net.knots_u, net.knots_v), net.control_points[..., :2]
+    )
     samples = []
-    for degree, knots, n in ((degree_u, knots_u, net.shape[0]), (degree_v, knots_v, net.shape[1])):
+    for degree, knots, n in (
+        (net.degree_u, net.knots_u, net.shape[0]),
+        (net.degree_v, net.knots_v, net.shape[1]),
+    ):
         breaks = np.unique(knots[degree : n + 1])
         steps = (np.arange(per_span) + 0.5) / per_span
         samples.append((breaks[:-1, None] + np.diff(breaks)[:, None] * steps).reshape(-1))
     uu, vv = np.meshgrid(samples[0], samples[1], indexing="ij")
-    d = surface_derivatives(
-        degree_u, degree_v, knots_u, knots_v, net, None, uu.reshape(-1), vv.reshape(-1), order=1
-    )
+    d = surface_derivatives(planar, uu.reshape(-1), vv.reshape(-1), order=1)
     jac = d[:, 1, 0, 0] * d[:, 0, 1, 1] - d[:, 1, 0, 1] * d[:, 0, 1, 0]
     if skip is not None:
         (u0, u1), (v0, v1) = skip

@@ -26,7 +26,7 @@ from scipy.spatial import cKDTree
 
 from geobrep import Entity, NurbsSurface
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.geometry.nurbs import greville_abscissae, surface_points
+from geobrep.geometry.nurbs import NurbsNet, greville_abscissae, surface_points
 from geobrep.plugins import FitResult
 from geobrep.plugins.fit.approximation import (
     NetFit,
@@ -36,7 +36,12 @@ from geobrep.plugins.fit.approximation import (
     solve_net,
 )
 from geobrep.plugins.fit.distance import surface_distances
-from geobrep.plugins.fit.domain_map import check_fold_free, fill_net, piecewise_linear
+from geobrep.plugins.fit.domain_map import (
+    check_fold_free,
+    fill_net,
+    piecewise_linear,
+    planar_map,
+)
 from geobrep.plugins.fit.frame import LocalFrame
 from geobrep.plugins.fit.options import HybridOptions
 from geobrep.plugins.fit.projection import invert_planar_map
@@ -173,10 +178,10 @@ def _fit_level(
     breaks: tuple[tuple[float, float], tuple[float, float]],
     lam: float,
 ) -> tuple[NetFit, Layout]:
-    p, q = skinned.degree_u, skinned.degree_v
-    ku, iu0 = layout_knots(p, skinned.knots_u, int(spans[0]), int(spans[1]), breaks[0])
-    kv, jv0 = layout_knots(q, skinned.knots_v, int(spans[2]), int(spans[3]), breaks[1])
-    core = skinned.control_points
+    p, q = skinned.net.degree_u, skinned.net.degree_v
+    ku, iu0 = layout_knots(p, skinned.net.knots_u, int(spans[0]), int(spans[1]), breaks[0])
+    kv, jv0 = layout_knots(q, skinned.net.knots_v, int(spans[2]), int(spans[3]), breaks[1])
+    core = skinned.net.control_points
     ncu, ncv = core.shape[:2]
     layout = Layout(ku, kv, breaks[0], breaks[1], (iu0, jv0), (ncu, ncv))
     nu, nv = ku.shape[0] - p - 1, kv.shape[0] - q - 1
@@ -190,10 +195,10 @@ def _fit_level(
     fixed[block] = True
     _outer_boundary(planar, fixed, core, layout, gu, gv, rect)
     planar = fill_net(gu * width, gv * height, planar, fixed)
-    check_fold_free(p, q, ku, kv, planar, LABEL, skip=breaks)
-    args = (p, q, ku, kv, np.concatenate([planar, np.zeros((nu, nv, 1))], axis=2), None)
-    u_rim, v_rim, _ = invert_planar_map(args, data.rim[:, :2])
-    u_exact, v_exact, _ = invert_planar_map(args, data.exact[:, :2])
+    in_plane = planar_map((p, q), (ku, kv), planar)
+    check_fold_free(in_plane, LABEL, skip=breaks)
+    u_rim, v_rim, _ = invert_planar_map(in_plane, data.rim[:, :2])
+    u_exact, v_exact, _ = invert_planar_map(in_plane, data.exact[:, :2])
     u_core, v_core = _core_parameters(skinned, layout)
     core_fixed = np.zeros((nu, nv), dtype=bool)
     core_fixed[block] = True
@@ -212,16 +217,12 @@ def _fit_level(
         exact=(u_exact, v_exact, data.exact[:, 2]),
         label=LABEL,
     )
-    net = np.concatenate([planar, heights], axis=2)
+    net = in_plane.with_control_points(np.concatenate([planar, heights], axis=2))
     u = np.concatenate([u_core, u_exact, u_rim])
     v = np.concatenate([v_core, v_exact, v_rim])
     local = np.concatenate([data.skinned, data.exact, data.rim])
-    residuals = np.linalg.norm(surface_points(p, q, ku, kv, net, None, u, v) - local, axis=1)
+    residuals = np.linalg.norm(surface_points(net, u, v) - local, axis=1)
     fitted = NetFit(
-        p,
-        q,
-        ku,
-        kv,
         net,
         u,
         v,
@@ -254,58 +255,33 @@ def seam_gap(
     Each rim patch is cut out of the merged net as its own clamped surface and evaluated on the
     seam; the core is evaluated on its own boundary. Both are taken about the net's centre.
     """
-    net = np.asarray(surface.control_points)
-    centre = 0.5 * (net.reshape(-1, 3).min(axis=0) + net.reshape(-1, 3).max(axis=0))
-    p, q = surface.degree_u, surface.degree_v
-    ku, kv = np.asarray(surface.knots_u), np.asarray(surface.knots_v)
+    net = surface.net
+    centre = net.centre
+    points = net.control_points - centre
+    p, q, ku, kv = net.degree_u, net.degree_v, net.knots_u, net.knots_v
     iu0, jv0 = layout.offset
     ncu, ncv = layout.core_shape
     (a0, a1), (b0, b1) = layout.breaks_u, layout.breaks_v
-    core_net = np.asarray(core.control_points) - centre
+    core_net = core.net.with_control_points(core.net.control_points - centre)
     t = np.linspace(0.0, 1.0, samples)
+    u_seam, v_seam = a0 + t * (a1 - a0), b0 + t * (b1 - b0)
+    zeros, ones = np.zeros(samples), np.ones(samples)
+    left = NurbsNet(p, q, np.r_[ku[: iu0 + p + 1], a0], kv, points[: iu0 + 1])
+    right = NurbsNet(p, q, np.r_[a1, ku[iu0 + ncu :]], kv, points[iu0 + ncu - 1 :])
+    bottom = NurbsNet(p, q, ku, np.r_[kv[: jv0 + q + 1], b0], points[:, : jv0 + 1])
+    top = NurbsNet(p, q, ku, np.r_[b1, kv[jv0 + ncv :]], points[:, jv0 + ncv - 1 :])
+    # each rim patch with the seam's parameters on it, then on the core
+    seams = (
+        (left, a0 + zeros, v_seam),
+        (right, a1 + zeros, v_seam),
+        (bottom, u_seam, b0 + zeros),
+        (top, u_seam, b1 + zeros),
+    )
+    on_core = ((zeros, t), (ones, t), (t, zeros), (t, ones))
     gap = 0.0
-
-    def patch(rows: slice, knots_rows: FloatArray, axis: int) -> FloatArray:
-        sub = net[rows] if axis == 0 else net[:, rows]
-        return np.asarray(sub - centre)
-
-    # left and right seams (u = a0, u = a1), restricted to the core's v range
-    left_knots = np.r_[ku[: iu0 + p + 1], a0]
-    left = patch(slice(0, iu0 + 1), left_knots, 0)
-    right_knots = np.r_[a1, ku[iu0 + ncu :]]
-    right = patch(slice(iu0 + ncu - 1, None), right_knots, 0)
-    v_global = b0 + t * (b1 - b0)
-    for knots, sub, at, edge in ((left_knots, left, a0, 0.0), (right_knots, right, a1, 1.0)):
-        rim_points = surface_points(p, q, knots, kv, sub, None, np.full(samples, at), v_global)
-        core_points = surface_points(
-            p,
-            q,
-            np.asarray(core.knots_u),
-            np.asarray(core.knots_v),
-            core_net,
-            None,
-            np.full(samples, edge),
-            t,
-        )
-        gap = max(gap, float(np.linalg.norm(rim_points - core_points, axis=1).max()))
-    bottom_knots = np.r_[kv[: jv0 + q + 1], b0]
-    bottom = patch(slice(0, jv0 + 1), bottom_knots, 1)
-    top_knots = np.r_[b1, kv[jv0 + ncv :]]
-    top = patch(slice(jv0 + ncv - 1, None), top_knots, 1)
-    u_global = a0 + t * (a1 - a0)
-    for knots, sub, at, edge in ((bottom_knots, bottom, b0, 0.0), (top_knots, top, b1, 1.0)):
-        rim_points = surface_points(p, q, ku, knots, sub, None, u_global, np.full(samples, at))
-        core_points = surface_points(
-            p,
-            q,
-            np.asarray(core.knots_u),
-            np.asarray(core.knots_v),
-            core_net,
-            None,
-            t,
-            np.full(samples, edge),
-        )
-        gap = max(gap, float(np.linalg.norm(rim_points - core_points, axis=1).max()))
+    for (rim, u_rim, v_rim), (u_core, v_core) in zip(seams, on_core, strict=True):
+        apart = surface_points(rim, u_rim, v_rim) - surface_points(core_net, u_core, v_core)
+        gap = max(gap, float(np.linalg.norm(apart, axis=1).max()))
     return gap
 
 
@@ -361,7 +337,7 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
     rim_index = np.flatnonzero(~core_mask)
     order = np.concatenate([skinned_index, exact_index, rim_index])
     data = _Data(local[skinned_index], local[exact_index], local[rim_index])
-    core_net = skinned.control_points
+    core_net = skinned.net.control_points
     outline = np.concatenate([local[:, :2], core_net[..., :2].reshape(-1, 2)])
     lo, hi = outline.min(axis=0), outline.max(axis=0)
     margin = 0.02 * float((hi - lo).max())
@@ -398,8 +374,8 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
     core_surface = NurbsSurface(
         degree_u=p,
         degree_v=q,
-        knots_u=skinned.knots_u,
-        knots_v=skinned.knots_v,
+        knots_u=skinned.net.knots_u,
+        knots_v=skinned.net.knots_v,
         control_points=frame.to_world(core_net.reshape(-1, 3)).reshape(core_net.shape),
         weights=np.ones(core_net.shape[:2]),
         name="hybrid core",
@@ -412,7 +388,7 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
     notes = list(fitted.notes)
     rim_sigma = sigma(distances[~core_mask])
     if options.epsilon is not None and not rim_sigma < options.epsilon:
-        nu, nv = fitted.net.shape[:2]
+        nu, nv = fitted.net.shape
         notes.append(
             f"ε = {options.epsilon:g} cannot be met on the rim: σ = {rim_sigma:.4g} with the "
             f"finest rim net the data support ({nu} × {nv} control points overall for {n_rim} "

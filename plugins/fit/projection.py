@@ -16,39 +16,25 @@ over every knot span (a k-d tree query), or from the caller (a fitter knows its 
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from geobrep import NurbsSurface
-from geobrep.geometry.nurbs import surface_derivatives, surface_grid, surface_points
+from geobrep.geometry.nurbs import NurbsNet, surface_derivatives, surface_grid, surface_points
 
-__all__ = ["SurfaceArgs", "initial_parameters", "invert_planar_map", "project_points"]
+__all__ = ["initial_parameters", "invert_planar_map", "project_points"]
 
 FloatArray = NDArray[np.float64]
-SurfaceArgs = tuple[int, int, FloatArray, FloatArray, FloatArray, FloatArray | None]
 
 
-def _args(surface: NurbsSurface | SurfaceArgs) -> SurfaceArgs:
-    if isinstance(surface, NurbsSurface):
-        weights = np.asarray(surface.weights) if surface.is_rational else None
-        return (
-            surface.degree_u,
-            surface.degree_v,
-            np.asarray(surface.knots_u),
-            np.asarray(surface.knots_v),
-            np.asarray(surface.control_points),
-            weights,
-        )
-    return surface
+def _net(surface: NurbsSurface | NurbsNet) -> NurbsNet:
+    return surface.net if isinstance(surface, NurbsSurface) else surface
 
 
-def _domain(args: SurfaceArgs) -> tuple[float, float, float, float]:
-    p, q, ku, kv, net, _ = args
-    nu, nv = net.shape[0], net.shape[1]
-    return float(ku[p]), float(ku[nu]), float(kv[q]), float(kv[nv])
+def _domain(net: NurbsNet) -> tuple[float, float, float, float]:
+    (umin, umax), (vmin, vmax) = net.domain
+    return umin, umax, vmin, vmax
 
 
 def _samples(degree: int, knots: FloatArray, n_ctrl: int, per_span: int) -> FloatArray:
@@ -59,14 +45,13 @@ def _samples(degree: int, knots: FloatArray, n_ctrl: int, per_span: int) -> Floa
 
 
 def initial_parameters(
-    surface: NurbsSurface | SurfaceArgs, points: FloatArray, per_span: int = 4, channels: int = 3
+    surface: NurbsSurface | NurbsNet, points: FloatArray, per_span: int = 4, channels: int = 3
 ) -> tuple[FloatArray, FloatArray]:
     """Parameters of the grid sample nearest to each point (``channels`` = 2 compares x, y only)."""
-    args = _args(surface)
-    p, q, ku, kv, net, _ = args
-    u = _samples(p, ku, net.shape[0], per_span)
-    v = _samples(q, kv, net.shape[1], per_span)
-    grid = surface_grid(*args, u, v)
+    net = _net(surface)
+    u = _samples(net.degree_u, net.knots_u, net.shape[0], per_span)
+    v = _samples(net.degree_v, net.knots_v, net.shape[1], per_span)
+    grid = surface_grid(net, u, v)
     tree = cKDTree(grid.reshape(-1, 3)[:, :channels])
     _, index = tree.query(points[:, :channels])
     iu, iv = np.divmod(np.asarray(index, dtype=np.int64), v.shape[0])
@@ -74,7 +59,7 @@ def initial_parameters(
 
 
 def project_points(
-    surface: NurbsSurface | SurfaceArgs,
+    surface: NurbsSurface | NurbsNet,
     points: FloatArray,
     u0: FloatArray | None = None,
     v0: FloatArray | None = None,
@@ -88,19 +73,20 @@ def project_points(
     edges) do not trap a point. Parameters are clamped to the domain, so points beyond an edge
     project onto it.
     """
-    args = _args(surface)
+    net = _net(surface)
     pts = np.asarray(points, dtype=np.float64)
     if u0 is None or v0 is None:
-        u0, v0 = initial_parameters(args, pts)
+        u0, v0 = initial_parameters(net, pts)
     u = np.array(u0, dtype=np.float64)
     v = np.array(v0, dtype=np.float64)
-    umin, umax, vmin, vmax = _domain(args)
-    scale = float(np.ptp(args[4].reshape(-1, args[4].shape[-1])[:, :3], axis=0).max()) or 1.0
+    umin, umax, vmin, vmax = _domain(net)
+    flat = net.control_points.reshape(-1, net.channels)
+    scale = float(np.ptp(flat[:, :3], axis=0).max()) or 1.0
     active = np.arange(pts.shape[0])
     for _ in range(iterations):
         if active.size == 0:
             break
-        d = surface_derivatives(*args, u[active], v[active], order=2)
+        d = surface_derivatives(net, u[active], v[active], order=2)
         s, su, sv = d[:, 0, 0], d[:, 1, 0], d[:, 0, 1]
         suu, suv, svv = d[:, 2, 0], d[:, 1, 1], d[:, 0, 2]
         target = pts[active]
@@ -130,7 +116,7 @@ def project_points(
         for _ in range(8):
             cu = np.clip(u[active[pending]] + step[pending] * du[pending], umin, umax)
             cv = np.clip(v[active[pending]] + step[pending] * dv[pending], vmin, vmax)
-            trial = surface_points(*args, cu, cv) - target[pending]
+            trial = surface_points(net, cu, cv) - target[pending]
             better = np.einsum("ij,ij->i", trial, trial) <= before[pending]
             new_u[pending[better]] = cu[better]
             new_v[pending[better]] = cv[better]
@@ -141,7 +127,7 @@ def project_points(
         moved = np.sqrt((new_u - u[active]) ** 2 * a11 + (new_v - v[active]) ** 2 * a22)
         u[active], v[active] = new_u, new_v
         active = active[moved > 1e-15 * scale]
-    d = surface_derivatives(*args, u, v, order=1)
+    d = surface_derivatives(net, u, v, order=1)
     foot, su, sv = d[:, 0, 0], d[:, 1, 0], d[:, 0, 1]
     normal = np.cross(su, sv)
     length = np.linalg.norm(normal, axis=1)
@@ -153,7 +139,7 @@ def project_points(
 
 
 def invert_planar_map(
-    surface: SurfaceArgs,
+    planar_map: NurbsNet,
     targets: FloatArray,
     u0: FloatArray | None = None,
     v0: FloatArray | None = None,
@@ -161,22 +147,23 @@ def invert_planar_map(
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Parameters ``(u, v)`` where the map's first two coordinates reach ``targets (m, 2)``.
 
-    Returns the parameters and the remaining planar distance (non-zero for targets outside the
-    mapped region, which are clamped to the domain).
+    ``planar_map`` is a net of three channels whose first two are the map. Returns the
+    parameters and the remaining planar distance (non-zero for targets outside the mapped
+    region, which are clamped to the domain).
     """
-    args = surface
+    net = planar_map
     pts = np.asarray(targets, dtype=np.float64)[:, :2]
     if u0 is None or v0 is None:
-        u0, v0 = initial_parameters(args, np.column_stack([pts, np.zeros(len(pts))]), channels=2)
+        u0, v0 = initial_parameters(net, np.column_stack([pts, np.zeros(len(pts))]), channels=2)
     u = np.array(u0, dtype=np.float64)
     v = np.array(v0, dtype=np.float64)
-    umin, umax, vmin, vmax = _domain(args)
-    scale = float(np.ptp(args[4].reshape(-1, 3)[:, :2], axis=0).max()) or 1.0
+    umin, umax, vmin, vmax = _domain(net)
+    scale = float(np.ptp(net.control_points.reshape(-1, 3)[:, :2], axis=0).max()) or 1.0
     active = np.arange(pts.shape[0])
     for _ in range(iterations):
         if active.size == 0:
             break
-        d = surface_derivatives(*args, u[active], v[active], order=1)
+        d = surface_derivatives(net, u[active], v[active], order=1)
         r = pts[active] - d[:, 0, 0, :2]
         xu, yu = d[:, 1, 0, 0], d[:, 1, 0, 1]
         xv, yv = d[:, 0, 1, 0], d[:, 0, 1, 1]
@@ -191,11 +178,6 @@ def invert_planar_map(
         )
         u[active], v[active] = new_u, new_v
         active = active[moved > 1e-15 * scale]
-    d = surface_derivatives(*args, u, v, order=0)
+    d = surface_derivatives(net, u, v, order=0)
     residual = np.linalg.norm(pts - d[:, 0, 0, :2], axis=1)
     return u, v, residual
-
-
-def as_surface_args(surface: Any) -> SurfaceArgs:
-    """The evaluation arguments of a NurbsSurface (or pass a tuple through)."""
-    return _args(surface)

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from geobrep.errors import DegenerateGeometryError, OptionsError
-from geobrep.geometry.nurbs import basis_matrix, surface_points
+from geobrep.geometry.nurbs import NurbsNet, basis_matrix, surface_points
 from geobrep.plugins.fit.curves import BSplineCurve, interpolate_curve
 from geobrep.plugins.fit.knots import averaged_knots, chord_parameters, merge_knots
 
@@ -40,31 +40,18 @@ IntArray = NDArray[np.int64]
 
 @dataclass(frozen=True)
 class SkinnedNet:
-    """A skinned B-spline surface with the parameters of the points it interpolates.
+    """A skinned B-spline net with the parameters of the points it interpolates.
 
     ``row_parameters[k]`` are the u parameters of row ``k``'s points, ``section_parameters[k]``
     its v parameter.
     """
 
-    degree_u: int
-    degree_v: int
-    knots_u: FloatArray
-    knots_v: FloatArray
-    control_points: FloatArray
+    net: NurbsNet
     row_parameters: list[FloatArray]
     section_parameters: FloatArray
 
     def evaluate(self, u: FloatArray, v: FloatArray) -> FloatArray:
-        return surface_points(
-            self.degree_u,
-            self.degree_v,
-            self.knots_u,
-            self.knots_v,
-            self.control_points,
-            None,
-            u,
-            v,
-        )
+        return surface_points(self.net, u, v)
 
     def point_parameters(self) -> tuple[FloatArray, FloatArray]:
         """``(u, v)`` of every input point, rows concatenated in order."""
@@ -131,11 +118,7 @@ def skin_rows(
         raise DegenerateGeometryError(f"{label}: the cross-sectional system is singular") from exc
     control = net.reshape(n_sections, n_u, 3).transpose(1, 0, 2)
     return SkinnedNet(
-        degree_u=degree_u,
-        degree_v=degree_v,
-        knots_u=knots_u,
-        knots_v=knots_v,
-        control_points=np.ascontiguousarray(control),
+        net=NurbsNet(degree_u, degree_v, knots_u, knots_v, np.ascontiguousarray(control)),
         row_parameters=[c.parameters for c in compatible],
         section_parameters=section,
     )

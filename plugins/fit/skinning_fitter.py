@@ -92,13 +92,13 @@ def fit_skinning(entities: list[Entity], options: SkinningOptions) -> FitResult:
     order = np.concatenate(rows)
     if np.unique(order).size != order.size or order.size != points.shape[0]:
         raise DegenerateGeometryError(f"{LABEL}: a point belongs to no row or to several rows")
-    net = skinned.control_points
+    net = skinned.net.control_points
     world = frame.to_world(net.reshape(-1, 3)).reshape(net.shape)
     surface = NurbsSurface(
-        degree_u=skinned.degree_u,
-        degree_v=skinned.degree_v,
-        knots_u=skinned.knots_u,
-        knots_v=skinned.knots_v,
+        degree_u=skinned.net.degree_u,
+        degree_v=skinned.net.degree_v,
+        knots_u=skinned.net.knots_u,
+        knots_v=skinned.net.knots_v,
         control_points=world,
         weights=np.ones(net.shape[:2]),
         name="skinning",
@@ -111,14 +111,7 @@ def fit_skinning(entities: list[Entity], options: SkinningOptions) -> FitResult:
     distances = surface_distances(surface, points, u, v)
     notes = []
     try:
-        check_fold_free(
-            skinned.degree_u,
-            skinned.degree_v,
-            skinned.knots_u,
-            skinned.knots_v,
-            net[..., :2],
-            LABEL,
-        )
+        check_fold_free(skinned.net, LABEL)
     except DegenerateGeometryError:
         notes.append(
             "the skinned surface folds over in plan somewhere (sections of very different "

@@ -252,14 +252,14 @@ class TestGrid:
         fitted = approximate_points(points, options, frame)
         general = solve_net(
             (3, 3),
-            (fitted.knots_u, fitted.knots_v),
+            (fitted.net.knots_u, fitted.net.knots_v),
             fitted.u,
             fitted.v,
             frame.to_local(points),
             lam=0.0,
             lengths=(1.0, 1.0),
         )
-        np.testing.assert_allclose(fitted.net, general, atol=1e-8)
+        np.testing.assert_allclose(fitted.net.control_points, general, atol=1e-8)
 
     def test_matches_geomdl_with_no_more_error(self) -> None:
         from geomdl import fitting as geomdl_fitting

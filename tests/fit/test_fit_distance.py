@@ -6,6 +6,7 @@ import numpy as np
 from fit_helpers import UTM, sphere_octant
 
 from geobrep import NurbsSurface, Surface
+from geobrep.geometry.nurbs import NurbsNet
 from geobrep.plugins.fit.distance import (
     closest_points_on_triangles,
     mesh_distances,
@@ -103,11 +104,11 @@ def test_invert_planar_map() -> None:
     for j, radius in enumerate((1.0, 2.0)):
         net[:, j, :2] = arc * radius
     weights = np.array([[1.0, 1.0], [s, s], [1.0, 1.0]])
-    args = (2, 1, knots, np.array([0.0, 0.0, 1.0, 1.0]), net, weights)
+    annulus = NurbsNet(2, 1, knots, np.array([0.0, 0.0, 1.0, 1.0]), net, weights)
     rng = np.random.default_rng(0)
     angle = rng.uniform(0, np.pi / 2, 200)
     radius = rng.uniform(1.0, 2.0, 200)
     targets = np.column_stack([radius * np.cos(angle), radius * np.sin(angle)])
-    _, v, off = invert_planar_map(args, targets)
+    _, v, off = invert_planar_map(annulus, targets)
     assert off.max() < 1e-10
     np.testing.assert_allclose(v, radius - 1.0, atol=1e-10)

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from geobrep import NurbsSurface
 from geobrep.errors import EntityValidationError
 from geobrep.geometry.nurbs import (
+    NurbsNet,
     basis_derivatives,
     basis_functions,
     basis_matrix,
@@ -84,13 +85,13 @@ def test_evaluation_matches_geomdl_on_random_surfaces(rational: bool) -> None:
 def test_grid_evaluation_equals_pointwise() -> None:
     rng = np.random.default_rng(3)
     s = random_surface(rng, rational=True)
-    args = (s.degree_u, s.degree_v, s.knots_u, s.knots_v, s.control_points, s.weights)
+    net = NurbsNet(s.degree_u, s.degree_v, s.knots_u, s.knots_v, s.control_points, s.weights)
     u, v = rng.uniform(0, 1, 9), rng.uniform(0, 1, 7)
-    grid = surface_grid(*args, u, v)
-    points = surface_points(*args, np.repeat(u, 7), np.tile(v, 9))
+    grid = surface_grid(net, u, v)
+    points = surface_points(net, np.repeat(u, 7), np.tile(v, 9))
     np.testing.assert_allclose(grid.reshape(-1, 3), points, atol=1e-14)
     assert surface_derivatives(
-        *args, u, v[:9] if v.size >= 9 else np.r_[v, v][:9], order=1
+        net, u, v[:9] if v.size >= 9 else np.r_[v, v][:9], order=1
     ).shape == (9, 2, 2, 3)
 
 
@@ -161,3 +162,91 @@ def test_domain_and_evaluate_on_entity() -> None:
     )
     assert s.domain == ((2.0, 4.0), (0.0, 1.0))
     np.testing.assert_allclose(s.evaluate([3.0], [0.5]), [[0.5, 0.5, 0.0]])
+
+
+class TestNurbsNet:
+    """The value type the evaluators take: checked once, derived values agree with the entity."""
+
+    def test_a_surface_and_its_net_agree(self) -> None:
+        rng = np.random.default_rng(8)
+        for rational in (False, True):
+            s = random_surface(rng, rational)
+            net = s.net
+            assert net.shape == s.shape
+            assert net.domain == s.domain
+            assert net.is_rational == s.is_rational
+            assert (net.weights is None) == (not rational)
+            uv = rng.uniform(0, 1, (50, 2))
+            np.testing.assert_array_equal(
+                surface_points(net, uv[:, 0], uv[:, 1]), s.evaluate(uv[:, 0], uv[:, 1])
+            )
+
+    def test_equal_weights_evaluate_as_a_b_spline(self) -> None:
+        rng = np.random.default_rng(9)
+        s = random_surface(rng, rational=False)
+        plain = NurbsNet(s.degree_u, s.degree_v, s.knots_u, s.knots_v, s.control_points)
+        weighted = NurbsNet(
+            s.degree_u, s.degree_v, s.knots_u, s.knots_v, s.control_points, np.full(s.shape, 2.5)
+        )
+        assert not weighted.is_rational
+        u, v = rng.uniform(0, 1, 30), rng.uniform(0, 1, 30)
+        np.testing.assert_array_equal(surface_points(plain, u, v), surface_points(weighted, u, v))
+
+    def test_centre_and_other_control_points(self) -> None:
+        s = sphere_octant(radius=50.0, centre=UTM)
+        net = s.net
+        flat = s.control_points.reshape(-1, 3)
+        np.testing.assert_array_equal(net.centre, 0.5 * (flat.min(axis=0) + flat.max(axis=0)))
+        moved = net.with_control_points(net.control_points - net.centre)
+        assert moved.weights is net.weights
+        assert moved.knots_u is net.knots_u
+        # about the centre, UTM-scale nets keep the precision of the local coordinates
+        u, v = np.linspace(0, 1, 7), np.linspace(1, 0, 7)
+        local = surface_points(moved, u, v) - (UTM - net.centre)
+        np.testing.assert_allclose(np.linalg.norm(local, axis=1), 50.0, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(surface_points(moved, u, v) + net.centre, s.evaluate(u, v))
+
+    def test_many_channels_for_points_only(self) -> None:
+        k = np.array([0.0, 0.0, 1.0, 1.0])
+        heights = np.array([[[0.0], [1.0]], [[2.0], [3.0]]])  # bilinear h = 2u + v
+        net = NurbsNet(1, 1, k, k, heights)
+        assert net.channels == 1
+        assert surface_points(net, [0.5, 1.0], [0.5, 0.25]).tolist() == [[1.5], [2.25]]
+
+    @pytest.mark.parametrize(
+        ("change", "field", "reason"),
+        [
+            ({"control_points": np.zeros((3, 3))}, "control_points", "expected shape"),
+            ({"knots_u": np.array([0.0, 0.0, 1.0])}, "knots_u", "has 3 values"),
+            ({"knots_v": np.array([0.0, 0.0, 0.7, 0.5, 1.0, 1.0])}, "knots_v", "non-decreasing"),
+            ({"degree_u": 3}, "control_points", "need degree <= 2"),
+            ({"weights": np.ones((3, 2))}, "weights", "does not match"),
+            (
+                {"weights": np.array([[1.0, 1.0, 1.0]] * 2 + [[1.0, 0.0, 1.0]])},
+                "weights",
+                "positive",
+            ),
+        ],
+    )
+    def test_malformed_nets_are_refused(self, change: dict, field: str, reason: str) -> None:
+        good: dict = {
+            "degree_u": 1,
+            "degree_v": 2,
+            "knots_u": np.array([0.0, 0.0, 0.5, 1.0, 1.0]),
+            "knots_v": np.array([0.0, 0.0, 0.0, 1.0, 1.0, 1.0]),
+            "control_points": np.zeros((3, 3, 3)),
+            "weights": None,
+        }
+        NurbsNet(**good)
+        with pytest.raises(EntityValidationError, match=f"NurbsNet: {field}: .*{reason}"):
+            NurbsNet(**{**good, **change})
+
+    def test_the_entity_format_is_unchanged(self) -> None:
+        s = sphere_octant(radius=2.0)
+        dumped = s.model_dump()
+        assert "net" not in dumped
+        assert {"degree_u", "degree_v", "knots_u", "knots_v", "control_points", "weights"} <= set(
+            dumped
+        )
+        again = NurbsSurface.model_validate(dumped)
+        np.testing.assert_array_equal(again.net.control_points, s.net.control_points)

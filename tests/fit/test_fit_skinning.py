@@ -52,10 +52,10 @@ def test_rows_of_different_counts_are_interpolated_exactly() -> None:
         x[0], x[-1] = 0.0, 100.0
         y = 20.0 * k + rng.uniform(-2, 2, count)
         rows.append(np.column_stack([x, y, np.sin(x / 30) * 5 + y / 10]))
-    net = skin_rows(rows, degree_u=3, degree_v=3)
-    u, v = net.point_parameters()
-    np.testing.assert_allclose(net.evaluate(u, v), np.concatenate(rows), atol=1e-10)
-    assert net.control_points.shape[1] == 5
+    skinned = skin_rows(rows, degree_u=3, degree_v=3)
+    u, v = skinned.point_parameters()
+    np.testing.assert_allclose(skinned.evaluate(u, v), np.concatenate(rows), atol=1e-10)
+    assert skinned.net.shape[1] == 5
 
 
 def test_sections_as_polyline_parts_with_alternating_directions() -> None:

@@ -71,21 +71,25 @@ class NurbsSurface(Entity):
     @property
     def domain(self) -> tuple[tuple[float, float], tuple[float, float]]:
         """Parameter domain ``((u_min, u_max), (v_min, v_max))``."""
-        nu, nv = self.shape
-        return (
-            (float(self.knots_u[self.degree_u]), float(self.knots_u[nu])),
-            (float(self.knots_v[self.degree_v]), float(self.knots_v[nv])),
-        )
+        return self.net.domain
 
-    def _eval_args(self) -> nurbs_eval.SurfaceArgs:
-        weights = self.weights if self.is_rational else None
-        return (
+    @property
+    def net(self) -> nurbs_eval.NurbsNet:
+        """The evaluation net (degrees, knots, control points; weights only when rational).
+
+        >>> net = np.zeros((2, 2, 3)); net[1, :, 0] = 1; net[:, 1, 1] = 1
+        >>> s = NurbsSurface(degree_u=1, degree_v=1, knots_u=[0, 0, 1, 1], knots_v=[0, 0, 1, 1],
+        ...                  control_points=net)
+        >>> s.net.shape, s.net.weights is None
+        ((2, 2), True)
+        """
+        return nurbs_eval.NurbsNet(
             self.degree_u,
             self.degree_v,
             self.knots_u,
             self.knots_v,
             self.control_points,
-            weights,
+            self.weights if self.is_rational else None,
         )
 
     def evaluate(self, u: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
@@ -97,11 +101,11 @@ class NurbsSurface(Entity):
         >>> s.evaluate([0.5], [0.25]).tolist()
         [[0.5, 0.25, 0.0]]
         """
-        return nurbs_eval.surface_points(*self._eval_args(), u, v)
+        return nurbs_eval.surface_points(self.net, u, v)
 
     def derivatives(self, u: ArrayLike, v: ArrayLike, order: int = 1) -> NDArray[np.float64]:
         """Partial derivatives ``[:, k, l] = ∂^(k+l)S/∂u^k∂v^l`` (``k + l <= order``)."""
-        return nurbs_eval.surface_derivatives(*self._eval_args(), u, v, order=order)
+        return nurbs_eval.surface_derivatives(self.net, u, v, order=order)
 
     def tessellate(
         self, resolution: int | tuple[int, int] | None = None, tolerance: float | None = None
@@ -127,9 +131,7 @@ class NurbsSurface(Entity):
         if tolerance is not None and not tolerance > 0:
             raise self.fail("tessellate", f"tolerance must be > 0, got {tolerance}")
         try:
-            grid = nurbs_eval.tessellate(
-                *self._eval_args(), resolution=resolution, tolerance=tolerance
-            )
+            grid = nurbs_eval.tessellate(self.net, resolution=resolution, tolerance=tolerance)
         except ValueError as exc:
             raise self.fail("tessellate", str(exc)) from exc
         uu, vv = np.meshgrid(grid.u, grid.v, indexing="ij")
