@@ -17,6 +17,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+from geobrep.cli.common import format_name
 from geobrep.errors import FileAccessError, FormatError, OptionsError
 from geobrep.model.entities import Entity, PointSet, PolyLine
 from geobrep.ops.fitting import MAX_TRIANGLES
@@ -45,7 +46,11 @@ def add_parser(subparsers: Any) -> None:
         metavar="KEY=VALUE",
         help="a fitter option (VALUE is JSON when it parses, else text); repeatable",
     )
-    parser.add_argument("--format", help="input format name, when the extension is not enough")
+    parser.add_argument(
+        "--format",
+        type=format_name("read"),
+        help="input format name, when the extension is not enough",
+    )
     parser.add_argument("--entity", help="name of the PointSet to fit, when the file holds several")
     parser.add_argument("--report", help="also write the report as JSON to this file")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")

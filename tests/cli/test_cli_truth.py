@@ -366,3 +366,13 @@ def test_convert_to_an_extension_writes_that_extension(
     written = sorted(p.name for p in (tmp_path / "out").iterdir())
     assert written == ["modelA1.ml"]
     assert len(geobrep.read(tmp_path / "out" / "modelA1.ml").blocks) == 4
+
+
+def test_fit_names_an_unknown_input_format(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    points = DATA / "points.vs"
+    code, _, err = run(capsys, "fit", points, tmp_path / "x.ts", "--format", "gocadd")
+    assert code == 2
+    assert "unknown format 'gocadd'" in err
+    assert "did you mean 'gocad'" in err
