@@ -28,10 +28,10 @@ from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict
 
+from geobrep.adapters._file_format import file_format
 from geobrep.adapters.csv.table import read_points_table, write_points_table
 from geobrep.hookspecs import hookimpl
-from geobrep.host.capabilities import restrict_scene
-from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.host.registry import FormatCapabilities, FormatRegistry
 from geobrep.model.scene import Scene
 
 __all__ = ["CAPABILITIES", "CsvOptions", "geobrep_register_formats"]
@@ -58,32 +58,23 @@ def _sniff(head: bytes) -> bool:
     return looks_like_points_table(head)
 
 
-def _read(path: Path, options: BaseModel) -> Scene:
-    return read_points_table(path)
-
-
 def _write(scene: Scene, path: Path, options: CsvOptions) -> None:
-    write_points_table(
-        restrict_scene(scene, CAPABILITIES),
-        path,
-        delimiter=options.delimiter,
-        metadata=options.metadata,
-    )
+    write_points_table(scene, path, delimiter=options.delimiter, metadata=options.metadata)
 
 
 @hookimpl
 def geobrep_register_formats(registry: FormatRegistry) -> None:
     """Register ``csv`` (.csv, and tables of points under any name, found by content)."""
     registry.add(
-        FormatSpec(
-            name="csv",
-            description="points as delimited text: x, y, z columns, more columns as properties",
-            extensions=(".csv",),
-            reader=_read,
-            writer=_write,
-            sniff=_sniff,
-            options=CsvOptions,
+        file_format(
+            "csv",
+            "points as delimited text: x, y, z columns, more columns as properties",
+            (".csv",),
             capabilities=CAPABILITIES,
+            options=CsvOptions,
+            read=read_points_table,
+            write=_write,
+            sniff=_sniff,
             generic_content=True,  # plain numbers: a more specific format wins
         )
     )

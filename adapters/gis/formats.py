@@ -19,6 +19,7 @@ import re
 import shutil
 import tempfile
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import ConfigDict
 
+from geobrep.adapters._file_format import full_capabilities
 from geobrep.errors import FormatError, MissingDependencyError
 from geobrep.gis.feature_tables import (
     RESERVED_COLUMNS,
@@ -36,7 +38,7 @@ from geobrep.gis.feature_tables import (
     tables_to_entities,
 )
 from geobrep.gis.map_products import SECTION_FRAME_KEY
-from geobrep.host.registry import FormatCapabilities, FormatSpec
+from geobrep.host.registry import FormatSpec
 from geobrep.model.crs import CRS
 from geobrep.model.scene import Scene
 
@@ -531,46 +533,33 @@ def _losses(scene: Scene, path: Path) -> list[str]:
 
 def gis_formats() -> list[FormatSpec]:
     """The three GIS format specs."""
-    capabilities = FormatCapabilities(
-        entity_types=frozenset({"PointSet", "PolyLine", "Polygon", "Annotation"}),
-        point_data=True,
-        cell_data=True,
-        names=True,
-        ids=True,
-        crs=True,
-        multiple_entities=True,
+    capabilities = full_capabilities({"PointSet", "PolyLine", "Polygon", "Annotation"})
+    formats: tuple[tuple[str, str, str, Callable[[bytes], bool] | None], ...] = (
+        (
+            "gpkg",
+            ".gpkg",
+            "OGC GeoPackage: layers of points, lines, polygons with attributes",
+            _looks_like_geopackage,
+        ),
+        (
+            "geojson",
+            ".geojson",
+            "GeoJSON FeatureCollection (.geojson, or .json by content)",
+            looks_like_geojson,
+        ),
+        ("shapefile", ".shp", "ESRI shapefile (.shp with .shx, .dbf, .prj): one layer", None),
     )
     return [
         FormatSpec(
-            name="gpkg",
-            description="OGC GeoPackage: layers of points, lines, polygons with attributes",
-            extensions=(".gpkg",),
-            reader=_reader(_DRIVERS["gpkg"]),
-            writer=_writer(_DRIVERS["gpkg"]),
-            sniff=_looks_like_geopackage,
+            name=name,
+            description=description,
+            extensions=(extension,),
+            reader=_reader(_DRIVERS[name]),
+            writer=_writer(_DRIVERS[name]),
+            sniff=sniff,
             options=GisOptions,
             capabilities=capabilities,
             losses=_losses,
-        ),
-        FormatSpec(
-            name="geojson",
-            description="GeoJSON FeatureCollection (.geojson, or .json by content)",
-            extensions=(".geojson",),
-            reader=_reader(_DRIVERS["geojson"]),
-            writer=_writer(_DRIVERS["geojson"]),
-            sniff=looks_like_geojson,
-            options=GisOptions,
-            capabilities=capabilities,
-            losses=_losses,
-        ),
-        FormatSpec(
-            name="shapefile",
-            description="ESRI shapefile (.shp with .shx, .dbf, .prj): one layer",
-            extensions=(".shp",),
-            reader=_reader(_DRIVERS["shapefile"]),
-            writer=_writer(_DRIVERS["shapefile"]),
-            options=GisOptions,
-            capabilities=capabilities,
-            losses=_losses,
-        ),
+        )
+        for name, extension, description, sniff in formats
     ]

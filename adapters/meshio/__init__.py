@@ -15,12 +15,14 @@ ids, patch labels, properties, CRS and groups); the others keep what they can, a
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict
 
+from geobrep.adapters._file_format import file_format, full_capabilities
 from geobrep.adapters.cell_layout import (
     ENTITY_ARRAY,
     LAYOUT_TYPES,
@@ -41,8 +43,7 @@ from geobrep.adapters.meshio.header import (
 )
 from geobrep.errors import FormatError, MissingDependencyError
 from geobrep.hookspecs import hookimpl
-from geobrep.host.capabilities import restrict_scene
-from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec, NoOptions
+from geobrep.host.registry import FormatCapabilities, FormatRegistry, NoOptions
 from geobrep.model.scene import Scene
 
 __all__ = [
@@ -53,15 +54,7 @@ __all__ = [
     "geobrep_register_formats",
 ]
 
-_FULL = FormatCapabilities(
-    entity_types=LAYOUT_TYPES,
-    point_data=True,
-    cell_data=True,
-    names=True,
-    ids=True,
-    crs=True,
-    multiple_entities=True,
-)
+_FULL = full_capabilities(LAYOUT_TYPES)
 _SURFACE_ONLY = FormatCapabilities(entity_types=frozenset({"Surface"}))
 
 #: What each meshio-backed format holds, by format name.
@@ -105,20 +98,20 @@ class StlOptions(BaseModel):
     default ASCII STL keeps them exactly."""
 
 
-def _read_vtu(path: Path, options: BaseModel) -> Scene:
+def _read_vtu(path: Path) -> Scene:
     mesh = read_mesh(path, "vtu")
     return layout_to_scene(layout_from_mesh(mesh, path), path)
 
 
 def _write_vtu(scene: Scene, path: Path, options: VtuOptions) -> None:
-    layout = scene_to_layout(restrict_scene(scene, CAPABILITIES["vtu"]))
+    layout = scene_to_layout(scene)
     mesh = mesh_from_layout(layout, field_data=False)
     write_mesh(mesh, path, "vtu", binary=True, compression=options.compression)
     if layout.header is not None:
         embed_vtu_header(path, layout.header)
 
 
-def _read_legacy(path: Path, options: BaseModel) -> Scene:
+def _read_legacy(path: Path) -> Scene:
     with path.open("rb") as stream:
         head = stream.read(1024)
     if b"POLYDATA" in head or b"STRUCTURED_GRID" in head.replace(b"UNSTRUCTURED_GRID", b""):
@@ -158,23 +151,22 @@ def _read_through_pyvista(path: Path) -> Scene:
 
 
 def _write_legacy(scene: Scene, path: Path, options: LegacyVtkOptions) -> None:
-    layout = scene_to_layout(restrict_scene(scene, CAPABILITIES["vtk"]))
+    layout = scene_to_layout(scene)
     mesh = mesh_from_layout(layout, field_data=False)
     write_mesh(mesh, path, "vtk", binary=options.binary)
     if layout.header is not None:
         embed_legacy_header(path, layout.header, options.binary)
 
 
-def _reader(file_format: str):  # type: ignore[no-untyped-def]
-    def read(path: Path, options: BaseModel) -> Scene:
+def _reader(file_format: str) -> Callable[[Path], Scene]:
+    def read(path: Path) -> Scene:
         return layout_to_scene(layout_from_mesh(read_mesh(path, file_format), path), path)
 
     return read
 
 
-def _surface_writer(file_format: str):  # type: ignore[no-untyped-def]
-    def write(scene: Scene, path: Path, options: BaseModel) -> None:
-        kept = restrict_scene(scene, CAPABILITIES[file_format])
+def _surface_writer(file_format: str) -> Callable[[Scene, Path, BaseModel], None]:
+    def write(kept: Scene, path: Path, options: BaseModel) -> None:
         if not kept.surfaces:
             raise FormatError(f"{file_format.upper()} holds surfaces and the scene has none", path)
         shapes = {s.faces.shape[1] for s in kept.surfaces}
@@ -214,7 +206,7 @@ def _gmsh_losses(scene: Scene, path: Path) -> list[str]:
 
 
 def _gmsh_write(scene: Scene, path: Path, options: BaseModel) -> None:
-    layout = scene_to_layout(restrict_scene(scene, CAPABILITIES["gmsh"]))
+    layout = scene_to_layout(scene)
     layout.point_data = {
         name: values
         for name, values in layout.point_data.items()
@@ -232,7 +224,7 @@ def _gmsh_write(scene: Scene, path: Path, options: BaseModel) -> None:
     write_mesh(mesh, path, "gmsh22", binary=True)
 
 
-def _read_gmsh(path: Path, options: BaseModel) -> Scene:
+def _read_gmsh(path: Path) -> Scene:
     mesh = read_mesh(path, "gmsh")
     physical = mesh.cell_data.pop("gmsh:physical", None)
     mesh.cell_data.pop("gmsh:geometrical", None)
@@ -266,39 +258,39 @@ def _sniff_stl(head: bytes) -> bool:
 def geobrep_register_formats(registry: FormatRegistry) -> None:
     """Register ``vtu``, ``vtk``, ``gmsh``, ``obj``, ``stl`` and ``off``."""
     registry.add(
-        FormatSpec(
-            name="vtu",
-            description="VTK XML unstructured grid (meshio): whole scenes, exact",
-            extensions=(".vtu",),
-            reader=_read_vtu,
-            writer=_write_vtu,
-            sniff=_sniff_vtu,
-            options=VtuOptions,
+        file_format(
+            "vtu",
+            "VTK XML unstructured grid (meshio): whole scenes, exact",
+            (".vtu",),
             capabilities=CAPABILITIES["vtu"],
+            options=VtuOptions,
+            read=_read_vtu,
+            write=_write_vtu,
+            sniff=_sniff_vtu,
         )
     )
     registry.add(
-        FormatSpec(
-            name="vtk",
-            description="legacy VTK (meshio; POLYDATA through pyvista): whole scenes, exact",
-            extensions=(".vtk",),
-            reader=_read_legacy,
-            writer=_write_legacy,
-            sniff=_sniff_legacy,
-            options=LegacyVtkOptions,
+        file_format(
+            "vtk",
+            "legacy VTK (meshio; POLYDATA through pyvista): whole scenes, exact",
+            (".vtk",),
             capabilities=CAPABILITIES["vtk"],
+            options=LegacyVtkOptions,
+            read=_read_legacy,
+            write=_write_legacy,
+            sniff=_sniff_legacy,
         )
     )
     registry.add(
-        FormatSpec(
-            name="gmsh",
-            description="Gmsh 2.2 binary mesh (meshio): entity ids as physical tags",
-            extensions=(".msh",),
-            reader=_read_gmsh,
-            writer=_gmsh_write,
-            sniff=_sniff_gmsh,
-            options=NoOptions,
+        file_format(
+            "gmsh",
+            "Gmsh 2.2 binary mesh (meshio): entity ids as physical tags",
+            (".msh",),
             capabilities=CAPABILITIES["gmsh"],
+            options=NoOptions,
+            read=_read_gmsh,
+            write=_gmsh_write,
+            sniff=_sniff_gmsh,
             losses=_gmsh_losses,
         )
     )
@@ -308,14 +300,14 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
         ("off", "Geomview OFF (meshio): one surface", _sniff_off, NoOptions),
     ):
         registry.add(
-            FormatSpec(
-                name=name,
-                description=description,
-                extensions=(f".{name}",),
-                reader=_reader(name),
-                writer=_surface_writer(name),
-                sniff=sniff,
-                options=options,
+            file_format(
+                name,
+                description,
+                (f".{name}",),
                 capabilities=CAPABILITIES[name],
+                options=options,
+                read=_reader(name),
+                write=_surface_writer(name),
+                sniff=sniff,
             )
         )

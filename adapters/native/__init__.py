@@ -9,9 +9,10 @@ from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict
 
+from geobrep.adapters._file_format import file_format
 from geobrep.adapters.native.container import NativeDocument, load, looks_native, save
 from geobrep.hookspecs import hookimpl
-from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.host.registry import FormatCapabilities, FormatRegistry
 from geobrep.model.scene import Scene
 
 __all__ = ["NativeDocument", "NativeOptions", "geobrep_register_formats", "load", "save"]
@@ -26,10 +27,6 @@ class NativeOptions(BaseModel):
     """Deflate the arrays (smaller files, slower; the data stay bit-identical)."""
 
 
-def _read(path: Path, options: NativeOptions) -> Scene:
-    return load(path)
-
-
 def _write(scene: Scene, path: Path, options: NativeOptions) -> None:
     save(scene, path, compress=options.compress)
 
@@ -38,14 +35,14 @@ def _write(scene: Scene, path: Path, options: NativeOptions) -> None:
 def geobrep_register_formats(registry: FormatRegistry) -> None:
     """Register the ``native`` format (``.geobrep``)."""
     registry.add(
-        FormatSpec(
-            name="native",
-            description="geobrep's lossless scene container (zip of JSON + .npy arrays)",
-            extensions=(".geobrep",),
-            reader=_read,
-            writer=_write,
-            sniff=looks_native,
+        file_format(
+            "native",
+            "geobrep's lossless scene container (zip of JSON + .npy arrays)",
+            (".geobrep",),
             options=NativeOptions,
+            read=load,
+            write=_write,
+            sniff=looks_native,
             capabilities=FormatCapabilities(
                 entity_types=frozenset(
                     {

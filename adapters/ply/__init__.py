@@ -17,23 +17,15 @@ from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict
 
+from geobrep.adapters._file_format import file_format, full_capabilities
 from geobrep.adapters.ply.codec import read_ply, write_ply
 from geobrep.hookspecs import hookimpl
-from geobrep.host.capabilities import restrict_scene
-from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.host.registry import FormatRegistry
 from geobrep.model.scene import Scene
 
 __all__ = ["CAPABILITIES", "PlyOptions", "geobrep_register_formats", "read_ply", "write_ply"]
 
-CAPABILITIES = FormatCapabilities(
-    entity_types=frozenset({"PointSet", "PolyLine", "Surface"}),
-    point_data=True,
-    cell_data=True,
-    names=True,
-    ids=True,
-    crs=True,
-    multiple_entities=True,
-)
+CAPABILITIES = full_capabilities({"PointSet", "PolyLine", "Surface"})
 
 
 class PlyOptions(BaseModel):
@@ -45,12 +37,8 @@ class PlyOptions(BaseModel):
     """Little-endian binary (compact, fast); False writes ASCII. Both are exact."""
 
 
-def _read(path: Path, options: BaseModel) -> Scene:
-    return read_ply(path)
-
-
 def _write(scene: Scene, path: Path, options: PlyOptions) -> None:
-    write_ply(restrict_scene(scene, CAPABILITIES), path, binary=options.binary)
+    write_ply(scene, path, binary=options.binary)
 
 
 def _sniff(head: bytes) -> bool:
@@ -61,14 +49,14 @@ def _sniff(head: bytes) -> bool:
 def geobrep_register_formats(registry: FormatRegistry) -> None:
     """Register ``ply``."""
     registry.add(
-        FormatSpec(
-            name="ply",
-            description="Stanford PLY (plyfile): exact, all vertex and face properties",
-            extensions=(".ply",),
-            reader=_read,
-            writer=_write,
-            sniff=_sniff,
-            options=PlyOptions,
+        file_format(
+            "ply",
+            "Stanford PLY (plyfile): exact, all vertex and face properties",
+            (".ply",),
             capabilities=CAPABILITIES,
+            options=PlyOptions,
+            read=read_ply,
+            write=_write,
+            sniff=_sniff,
         )
     )

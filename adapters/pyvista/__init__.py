@@ -13,6 +13,7 @@ from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict
 
+from geobrep.adapters._file_format import file_format, full_capabilities
 from geobrep.adapters.cell_layout import layout_to_scene, scene_to_layout
 from geobrep.adapters.pyvista.convert import (
     dataset_to_layout,
@@ -25,7 +26,6 @@ from geobrep.adapters.pyvista.convert import (
 from geobrep.adapters.pyvista.render import RenderOptions, render_scene
 from geobrep.errors import FormatError
 from geobrep.hookspecs import hookimpl
-from geobrep.host.capabilities import restrict_scene
 from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
 from geobrep.model.scene import Scene
 
@@ -42,15 +42,7 @@ __all__ = [
     "to_pyvista",
 ]
 
-VTP_CAPABILITIES = FormatCapabilities(
-    entity_types=frozenset({"PointSet", "PolyLine", "Surface"}),
-    point_data=True,
-    cell_data=True,
-    names=True,
-    ids=True,
-    crs=True,
-    multiple_entities=True,
-)
+VTP_CAPABILITIES = full_capabilities({"PointSet", "PolyLine", "Surface"})
 PNG_CAPABILITIES = FormatCapabilities(
     entity_types=frozenset({"PointSet", "PolyLine", "Surface", "TetMesh", "LinearOctree"}),
     multiple_entities=True,
@@ -81,13 +73,13 @@ def read_vtk_dataset(path: Path, extension: str | None = None) -> Scene:
     return layout_to_scene(dataset_to_layout(dataset), path)
 
 
-def _read_vtp(path: Path, options: BaseModel) -> Scene:
+def _read_vtp(path: Path) -> Scene:
     return read_vtk_dataset(path, ".vtp")
 
 
 def _write_vtp(scene: Scene, path: Path, options: VtpOptions) -> None:
     import_pyvista("writing .vtp files")
-    layout = scene_to_layout(restrict_scene(scene, VTP_CAPABILITIES))
+    layout = scene_to_layout(scene)
     dataset = layout_to_dataset(layout)
     if not hasattr(dataset, "verts"):
         raise FormatError("a .vtp file holds no tetrahedra", path)
@@ -117,15 +109,15 @@ def _sniff_vtp(head: bytes) -> bool:
 def geobrep_register_formats(registry: FormatRegistry) -> None:
     """Register ``vtp`` and ``png``."""
     registry.add(
-        FormatSpec(
-            name="vtp",
-            description="VTK XML PolyData (pyvista, extra 'viz'): exact, whole scenes of meshes",
-            extensions=(".vtp",),
-            reader=_read_vtp,
-            writer=_write_vtp,
-            sniff=_sniff_vtp,
-            options=VtpOptions,
+        file_format(
+            "vtp",
+            "VTK XML PolyData (pyvista, extra 'viz'): exact, whole scenes of meshes",
+            (".vtp",),
             capabilities=VTP_CAPABILITIES,
+            options=VtpOptions,
+            read=_read_vtp,
+            write=_write_vtp,
+            sniff=_sniff_vtp,
         )
     )
     registry.add(
