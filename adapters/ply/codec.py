@@ -12,6 +12,7 @@ point set) keeping all vertices and every vertex and face property under its PLY
 from __future__ import annotations
 
 import importlib
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Final
 
@@ -257,9 +258,10 @@ def read_ply(path: Path) -> Scene:
         edges = np.column_stack([np.asarray(edge["vertex1"]), np.asarray(edge["vertex2"])])
     header = _header_of(ply)
     ids = {**face_data, **edge_data}
+    elements = _Elements(points, point_data, faces, face_data, edges, edge_data)
     if header is not None and (header_applies(header, ids) or faces is None):
-        return _from_header(path, header, points, point_data, faces, face_data, edges, edge_data)
-    return _foreign(path, points, point_data, faces, face_data, edges, edge_data)
+        return _from_header(path, header, elements)
+    return _foreign(path, elements)
 
 
 def _peek_header(path: Path) -> dict[str, Any] | None:
@@ -281,24 +283,29 @@ def _peek_header(path: Path) -> dict[str, Any] | None:
     return None
 
 
-def _from_header(
-    path: Path,
-    header: dict[str, Any],
-    points: NDArray[np.float64],
-    point_data: dict[str, NDArray[Any]],
-    faces: NDArray[np.int64] | None,
-    face_data: dict[str, NDArray[Any]],
-    edges: NDArray[np.int64] | None,
-    edge_data: dict[str, NDArray[Any]],
-) -> Scene:
+@dataclass(frozen=True)
+class _Elements:
+    """What a PLY file holds: vertices, faces and edges, each with its properties."""
+
+    points: NDArray[np.float64]
+    point_data: dict[str, NDArray[Any]]
+    faces: NDArray[np.int64] | None
+    face_data: dict[str, NDArray[Any]]
+    edges: NDArray[np.int64] | None
+    edge_data: dict[str, NDArray[Any]]
+
+
+def _from_header(path: Path, header: dict[str, Any], elements: _Elements) -> Scene:
+    """The scene geobrep wrote, rebuilt from its header comment."""
+    faces, edges = elements.faces, elements.edges
     blocks: list[tuple[str, NDArray[np.int64]]] = []
     pieces: list[dict[str, NDArray[Any]]] = []
     if faces is not None:
         blocks.append(("triangle" if faces.shape[1] == 3 else "quad", faces))
-        pieces.append(_regroup(face_data))
+        pieces.append(_regroup(elements.face_data))
     if edges is not None:
         blocks.append(("line", edges.astype(np.int64)))
-        pieces.append(_regroup(edge_data))
+        pieces.append(_regroup(elements.edge_data))
     point_sets = [r for r in header.get("entities", []) if r.get("type") == "PointSet"]
     for record in point_sets:
         start, stop = record["points"]
@@ -317,27 +324,22 @@ def _from_header(
                 parts.append(fill)
         cell_data[name] = parts[0] if len(parts) == 1 else np.concatenate(parts)
     layout = CellLayout(
-        points=points,
+        points=elements.points,
         blocks=blocks,
-        point_data=_regroup(point_data),
+        point_data=_regroup(elements.point_data),
         cell_data=cell_data,
         header=header,
     )
     return layout_to_scene(layout, path)
 
 
-def _foreign(
-    path: Path,
-    points: NDArray[np.float64],
-    point_data: dict[str, NDArray[Any]],
-    faces: NDArray[np.int64] | None,
-    face_data: dict[str, NDArray[Any]],
-    edges: NDArray[np.int64] | None,
-    edge_data: dict[str, NDArray[Any]],
-) -> Scene:
+def _foreign(path: Path, elements: _Elements) -> Scene:
+    """A PLY file of another program: one surface (and its edges) keeping every property."""
+    points, faces, edges = elements.points, elements.faces, elements.edges
+    face_data, edge_data = elements.face_data, elements.edge_data
     name = path.stem
     entities: list[Any] = []
-    props = PropertyMap(point_data)
+    props = PropertyMap(elements.point_data)
     if faces is not None and len(faces):
         if faces.min() < 0 or faces.max() >= len(points):
             raise FormatError(f"face refers to vertex {int(faces.max())} of {len(points)}", path)

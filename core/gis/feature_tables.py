@@ -644,6 +644,24 @@ def _annotation(table: FeatureTable, row: int, anchor: NDArray[np.float64]) -> A
     )
 
 
+def _closing_points(
+    coords: NDArray[np.float64], index: NDArray[np.int64], n_runs: int, min_points: int
+) -> tuple[NDArray[np.bool_], NDArray[np.bool_], NDArray[np.int64]]:
+    """Runs of ``coords`` (``index``: the run of each, in order) that close on themselves.
+
+    Returns per run whether it closes (at least ``min_points`` points, the last equal to the
+    first), per coordinate whether it is such a closing repeat (to drop), and per run the number
+    of points without it.
+    """
+    counts = np.bincount(index, minlength=n_runs)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    ends = starts + counts - 1
+    closed = (counts >= min_points) & np.all(coords[starts] == coords[np.maximum(ends, 0)], axis=1)
+    drop = np.zeros(coords.shape[0], dtype=bool)
+    drop[ends[closed]] = True
+    return closed, drop, (counts - closed).astype(np.int64)
+
+
 def _lines(
     table: FeatureTable,
     parts: NDArray[Any],
@@ -652,13 +670,7 @@ def _lines(
     problems: _Problems,
 ) -> list[Entity]:
     coords, index = _coordinates(parts, features, feature_z)
-    counts = np.bincount(index, minlength=parts.shape[0])
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-    ends = starts + counts - 1
-    closed = (counts >= 4) & np.all(coords[starts] == coords[np.maximum(ends, 0)], axis=1)
-    drop = np.zeros(coords.shape[0], dtype=bool)
-    drop[ends[closed]] = True
-    lengths = counts - closed
+    closed, drop, lengths = _closing_points(coords, index, parts.shape[0], 4)
     degenerate = lengths < 2
     problems.add("a line needs at least 2 points", np.unique(features[degenerate]))
     bad_feature = np.isin(features, features[degenerate])
@@ -701,13 +713,7 @@ def _polygons(
     shapely = _shapely()
     rings, ring_polygon = shapely.get_rings(parts, return_index=True)
     coords, index = _coordinates(rings, features[ring_polygon], feature_z)
-    counts = np.bincount(index, minlength=rings.shape[0])
-    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-    ends = starts + counts - 1
-    is_closed = (counts >= 1) & np.all(coords[starts] == coords[np.maximum(ends, 0)], axis=1)
-    drop = np.zeros(coords.shape[0], dtype=bool)
-    drop[ends[is_closed & (counts > 0)]] = True
-    sizes = counts - is_closed
+    _, drop, sizes = _closing_points(coords, index, rings.shape[0], 1)
     degenerate_polygon = np.zeros(parts.shape[0], dtype=bool)
     degenerate_polygon[ring_polygon[sizes < 3]] = True
     problems.add("a polygon ring needs at least 3 points", np.unique(features[degenerate_polygon]))

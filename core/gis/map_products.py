@@ -155,21 +155,11 @@ def block_outlines(scene: Scene, elevation: float = 0.0) -> list[Polygon]:
     >>> outline.metadata["layer"], outline.metadata["block"] == cake.blocks[0].id
     ('block_outlines', True)
     """
-    centre, diagonal = _centre(scene)
-    lift = _lift_to(centre, elevation)
-    outlines = []
-    for block in scene.blocks:
-        footprint = _footprint(scene.block_mesh(block), centre, diagonal)
-        polygon = _shapely_to_polygon(
-            footprint,
-            lift,
-            name=block.name,
-            kind="outline",
-            metadata=_block_metadata(block, "block_outlines"),
-        )
-        if polygon is not None:
-            outlines.append(polygon)
-    return outlines
+    blocks = (
+        (scene.block_mesh(block), block.name, _block_metadata(block, "block_outlines"))
+        for block in scene.blocks
+    )
+    return _outlines(scene, blocks, elevation)
 
 
 def surface_outlines(
@@ -182,18 +172,29 @@ def surface_outlines(
     >>> [p.name for p in surface_outlines(cake, kinds=["fault"])]
     ['fault']
     """
+    surfaces = (
+        (surface, surface.name, _surface_metadata(surface, "surface_outlines"))
+        for surface in scene.surfaces
+        if kinds is None or surface.kind in kinds
+    )
+    return _outlines(scene, surfaces, elevation)
+
+
+def _outlines(
+    scene: Scene, meshes: Iterable[tuple[Surface, str, dict[str, Any]]], elevation: float
+) -> list[Polygon]:
+    """The map outline of each ``(mesh, name, metadata)`` on the plane z = ``elevation``
+    (meshes without one give none)."""
     centre, diagonal = _centre(scene)
     lift = _lift_to(centre, elevation)
     outlines = []
-    for surface in scene.surfaces:
-        if kinds is not None and surface.kind not in kinds:
-            continue
+    for surface, name, metadata in meshes:
         polygon = _shapely_to_polygon(
             _footprint(surface, centre, diagonal),
             lift,
-            name=surface.name,
+            name=name,
             kind="outline",
-            metadata=_surface_metadata(surface, "surface_outlines"),
+            metadata=metadata,
         )
         if polygon is not None:
             outlines.append(polygon)
