@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import itertools
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Final, cast
 
@@ -204,33 +205,8 @@ def scene_to_layout(scene: Scene, reserved: frozenset[str] = frozenset()) -> Cel
         cell_counts.append(int(conn.shape[0]))
         part_column.append(parts)
     cell_offsets = np.cumsum([0, *cell_counts])
-    n_points = int(point_offsets[-1])
-    n_cells = int(cell_offsets[-1])
-
-    def arrays_for(kind: str) -> tuple[dict[str, NDArray[Any]], list[dict[str, Any]]]:
-        offsets = point_offsets if kind == "point_data" else cell_offsets
-        sizes: dict[str, set[tuple[int, ...]]] = {}
-        for entity in kept:
-            for name, prop in getattr(entity, kind).items():
-                sizes.setdefault(name, set()).add(prop.values.shape[1:])
-        pieces: dict[str, list[tuple[int, int, NDArray[Any]]]] = {}
-        records: list[dict[str, Any]] = []
-        for index, entity in enumerate(kept):
-            record: dict[str, Any] = {}
-            for name, prop in getattr(entity, kind).items():
-                array_name = _array_name(name)
-                if len(sizes[name]) > 1 or array_name in reserved:
-                    array_name = f"{array_name}#{entity.id}"
-                start, stop = int(offsets[index]), int(offsets[index + 1])
-                pieces.setdefault(array_name, []).append((start, stop, prop.values))
-                record[name] = _property_record(prop, array_name)
-            records.append(record)
-        total = n_points if kind == "point_data" else n_cells
-        merged = {name: _merge_arrays(parts, total, name) for name, parts in pieces.items()}
-        return merged, records
-
-    point_data, point_records = arrays_for("point_data")
-    cell_data, cell_records = arrays_for("cell_data")
+    point_data, point_records = _layout_arrays(kept, "point_data", point_offsets, reserved)
+    cell_data, cell_records = _layout_arrays(kept, "cell_data", cell_offsets, reserved)
     if len(kept) > 1:
         cell_data[ENTITY_ARRAY] = _small_ints(
             np.repeat(np.asarray([e.id for e in kept], dtype=np.int64), cell_counts)
@@ -245,28 +221,15 @@ def scene_to_layout(scene: Scene, reserved: frozenset[str] = frozenset()) -> Cel
             )
         )
     kept_ids = {e.id for e in kept}
-    entities: list[dict[str, Any]] = []
-    for index, entity in enumerate(kept):
-        record: dict[str, Any] = {
-            "id": entity.id,
-            "type": entity.type,
-            "name": entity.name,
-            "kind": entity.kind,
-            "metadata": entity.metadata,
-            "points": [int(point_offsets[index]), int(point_offsets[index + 1])],
-            "point_data": point_records[index],
-            "cell_data": cell_records[index],
-        }
-        if isinstance(entity, Surface):
-            record["patch_names"] = list(entity.patch_names)
-            record["has_patches"] = entity.patch_labels is not None
-        elif isinstance(entity, TetMesh):
-            record["region_names"] = list(entity.region_names)
-            record["has_regions"] = entity.region_labels is not None
-        elif isinstance(entity, PolyLine):
-            record["part_offsets"] = entity.part_offsets.tolist()
-            record["closed"] = entity.closed.tolist()
-        entities.append(record)
+    entities = [
+        _entity_record(
+            entity,
+            (int(point_offsets[index]), int(point_offsets[index + 1])),
+            point_records[index],
+            cell_records[index],
+        )
+        for index, entity in enumerate(kept)
+    ]
     header = {
         "format": HEADER_FORMAT,
         "version": HEADER_VERSION,
@@ -284,6 +247,62 @@ def scene_to_layout(scene: Scene, reserved: frozenset[str] = frozenset()) -> Cel
         cell_data=cell_data,
         header=header,
     )
+
+
+def _layout_arrays(
+    kept: Sequence[Entity], kind: str, offsets: NDArray[np.int64], reserved: frozenset[str]
+) -> tuple[dict[str, NDArray[Any]], list[dict[str, Any]]]:
+    """The ``kind`` (``point_data`` / ``cell_data``) arrays of the entities merged over the
+    layout (entity ``i`` owns elements ``offsets[i]:offsets[i + 1]``) and, per entity, the
+    header records of its properties."""
+    sizes: dict[str, set[tuple[int, ...]]] = {}
+    for entity in kept:
+        for name, prop in getattr(entity, kind).items():
+            sizes.setdefault(name, set()).add(prop.values.shape[1:])
+    pieces: dict[str, list[tuple[int, int, NDArray[Any]]]] = {}
+    records: list[dict[str, Any]] = []
+    for index, entity in enumerate(kept):
+        record: dict[str, Any] = {}
+        for name, prop in getattr(entity, kind).items():
+            array_name = _array_name(name)
+            if len(sizes[name]) > 1 or array_name in reserved:
+                array_name = f"{array_name}#{entity.id}"
+            start, stop = int(offsets[index]), int(offsets[index + 1])
+            pieces.setdefault(array_name, []).append((start, stop, prop.values))
+            record[name] = _property_record(prop, array_name)
+        records.append(record)
+    total = int(offsets[-1])
+    merged = {name: _merge_arrays(parts, total, name) for name, parts in pieces.items()}
+    return merged, records
+
+
+def _entity_record(
+    entity: Entity,
+    points: tuple[int, int],
+    point_records: dict[str, Any],
+    cell_records: dict[str, Any],
+) -> dict[str, Any]:
+    """The header entry of one entity: what its cells and points alone do not say."""
+    record: dict[str, Any] = {
+        "id": entity.id,
+        "type": entity.type,
+        "name": entity.name,
+        "kind": entity.kind,
+        "metadata": entity.metadata,
+        "points": list(points),
+        "point_data": point_records,
+        "cell_data": cell_records,
+    }
+    if isinstance(entity, Surface):
+        record["patch_names"] = list(entity.patch_names)
+        record["has_patches"] = entity.patch_labels is not None
+    elif isinstance(entity, TetMesh):
+        record["region_names"] = list(entity.region_names)
+        record["has_regions"] = entity.region_labels is not None
+    elif isinstance(entity, PolyLine):
+        record["part_offsets"] = entity.part_offsets.tolist()
+        record["closed"] = entity.closed.tolist()
+    return record
 
 
 def _has_parts(entity: Entity) -> bool:

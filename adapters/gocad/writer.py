@@ -8,7 +8,6 @@ the chosen type cannot hold are reported with a :class:`GocadWarning` (never dro
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,7 +38,9 @@ from geobrep.errors import FormatError
 from geobrep.geometry.bbox import column_extremes
 from geobrep.model.arcs import DEFAULT_RELATIVE_TOLERANCE
 from geobrep.model.entities import Block, Entity, PointSet, PolyLine, Surface, TetMesh
+from geobrep.model.properties import Property
 from geobrep.model.scene import Group, Scene
+from geobrep.model.topology import Arc, Patch
 
 __all__ = ["OBJECT_TYPES", "write_gocad"]
 
@@ -73,11 +74,11 @@ class _Writer:
         out: ObjectText,
         object_type: str,
         entity: Entity,
-        props: dict[str, Any],
-        cell_props: dict[str, Any],
+        props: dict[str, Property],
+        cell_props: dict[str, Property],
         cell_prefix: str,
         extra_header: tuple[tuple[str, str], ...] = (),
-    ) -> tuple[list[Any], list[Any], float]:
+    ) -> tuple[list[tuple[str, Property]], list[tuple[str, Property]], float]:
         in_model = object_type == "TSurf" and any(
             k == "name_in_model_list" for k, _ in extra_header
         )  # a Model3d member: its TFACE lines carry the type
@@ -104,7 +105,11 @@ class _Writer:
         return chosen, cell_chosen, z_sign_of(crs)
 
     def vertex_writer(
-        self, entity: Any, chosen: list[Any], z_sign: float, atom: str = "ATOM"
+        self,
+        entity: Surface | PolyLine | PointSet | TetMesh,
+        chosen: list[tuple[str, Property]],
+        z_sign: float,
+        atom: str = "ATOM",
     ) -> VertexWriter:
         values = value_columns(chosen, entity.n_points)
         flags = entity.point_data.get(FLAG_PROPERTY)
@@ -368,21 +373,51 @@ class _Writer:
     # -- Model3d --------------------------------------------------------------------------------
     def model3d(self) -> bytes:
         scene = self.scene
-        topology = scene.topology
-        patch_of = {(p.surface, p.label): p for p in topology.patches}
+        patch_of = {(p.surface, p.label): p for p in scene.topology.patches}
         surfaces = [
             s
             for s in scene.surfaces
             if any((int(s.id or 0), k) in patch_of for k in range(s.n_patches))
-        ]
-        if not surfaces:
-            surfaces = list(scene.surfaces)
+        ] or list(scene.surfaces)
         names = _unique_names([_model_name(s) for s in surfaces])
+        ordered = self._tface_order(surfaces, patch_of)
+        out = ObjectText()
+        model_meta = gocad_section(scene.metadata).get("model3d") or {}
+        out.add(f"GOCAD Model3d {model_meta.get('version', '1')}")
+        out.add(*header_lines("Model3d", scene.name, model_meta, None))
+        out.add(*crs_block(scene.crs))
+        for name in names:
+            out.add(f"TSURF {quote_rest(name)}")
+        name_of = {int(s.id or 0): n for s, n in zip(surfaces, names, strict=True)}
+        tfaces = _TFaceLines(patch_of, name_of, z_sign_of(scene.crs))
+        for number, (surface, label) in enumerate(ordered, start=1):
+            tfaces.add(out, number, surface, label)
+        blocks = list(scene.of_type(Block))
+        region_of = _region_ids(blocks, len(ordered) + 1)
+        for block in blocks:
+            _region_lines(out, block, region_of[int(block.id or 0)], tfaces)
+        self._model_lists(out, region_of, tfaces.tface_of, blocks)
+        out.add("END")  # unparsed header lines were reported on reading and are not written
+        pieces = [out.text()]
+        for surface in scene.surfaces:  # scene order; surfaces outside the model too
+            # a TSolid's SURFACEs too: the TSolid itself is not written in a Model3d
+            member = name_of.get(int(surface.id or 0))
+            extra = (("name_in_model_list", member),) if member is not None else ()
+            pieces.append(self.tsurf(surface, extra, tfaces.type_of.get(int(surface.id or 0))))
+        skipped = [e.label for e in scene.entities if not isinstance(e, Surface | Block)]
+        if skipped:
+            report(f"a Model3d holds surfaces and regions only; not written: {', '.join(skipped)}")
+        return b"".join(pieces)
+
+    def _tface_order(
+        self, surfaces: list[Surface], patch_of: dict[tuple[int, int], Patch]
+    ) -> list[tuple[Surface, int]]:
+        """``(surface, patch label)`` of each header TFACE: in patch-id order, each surface's
+        labels increasing (a patch without triangles is no TFACE)."""
         written = {int(s.id or 0): _written_labels(s).tolist() for s in surfaces}
-        for empty in topology.patches:
+        for empty in self.scene.topology.patches:
             if empty.label not in written.get(empty.surface, [empty.label]):
                 report(f"patch {empty.id} has no triangle: no TFACE is written for it")
-        # TFACE header entries: ordered by patch id, each surface's labels in increasing order.
         entries = [(s, k) for s in surfaces for k in written[int(s.id or 0)]]
         big = 1 << 62
         entries.sort(
@@ -400,72 +435,7 @@ class _Writer:
             labels = written[int(s.id or 0)]
             for k, position in enumerate(slots.get(int(s.id or 0), [])):
                 ordered[position] = (s, labels[k])
-        tface_of: dict[int, int] = {}
-        flipped: dict[int, bool] = {}
-        out = ObjectText()
-        model_meta = gocad_section(scene.metadata).get("model3d") or {}
-        out.add(f"GOCAD Model3d {model_meta.get('version', '1')}")
-        out.add(*header_lines("Model3d", scene.name, model_meta, None))
-        out.add(*crs_block(scene.crs))
-        z_sign = z_sign_of(scene.crs)
-        for name in names:
-            out.add(f"TSURF {quote_rest(name)}")
-        name_of = {int(s.id or 0): n for s, n in zip(surfaces, names, strict=True)}
-        tface_type: dict[int, str] = {}
-        for number, (surface, label) in enumerate(ordered, start=1):
-            patch = patch_of.get((int(surface.id or 0), label))
-            pmeta = gocad_section(patch.metadata) if patch is not None else {}
-            geo_type = pmeta.get("geological_type") or _surface_type(surface)
-            tface_type.setdefault(int(surface.id or 0), str(geo_type))
-            out.add(f"TFACE {number}  {geo_type} {quote_rest(name_of[int(surface.id or 0)])}")
-            faces = surface.patch_faces(label)  # never empty: empty patches are not written
-            key = pmeta.get("key_triangle")
-            if not (isinstance(key, int) and key in set(faces.tolist())):
-                key = int(faces[0])
-            corners = np.array(surface.vertices[surface.faces[key][:3]], dtype=np.float64)
-            reverse = bool(pmeta.get("key_reversed"))
-            if reverse:
-                corners = corners[::-1]
-            corners[:, 2] *= z_sign
-            for point in corners.tolist():
-                out.add("  " + " ".join(format_float(c) for c in point))
-            if patch is not None:
-                tface_of[patch.id] = number
-                flipped[patch.id] = reverse
-        blocks = [b for b in scene.of_type(Block)]
-        first_region = len(ordered) + 1
-        region_of: dict[int, int] = {}
-        for offset, block in enumerate(blocks):
-            region_of[int(block.id or 0)] = first_region + offset
-        kept = [gocad_metadata(b).get("region_id") for b in blocks]
-        valid = [k for k in kept if isinstance(k, int) and k >= first_region]
-        if len(valid) == len(kept) and len(set(valid)) == len(valid):
-            # the source's REGION ids are still valid: keep them
-            region_of = {int(b.id or 0): k for b, k in zip(blocks, valid, strict=True)}
-        for block in blocks:
-            values = []
-            for patch_id, side in block.sides:
-                if patch_id not in tface_of:
-                    report(f"{block.label}: patch {patch_id} has no TFACE; left out of its REGION")
-                    continue
-                sign = -side if flipped.get(patch_id) else side
-                values.append(sign * tface_of[patch_id])
-            name = "Universe" if block.is_universe else (block.name or f"region_{block.id}")
-            out.add(f"REGION {region_of[int(block.id or 0)]}  {quote_rest(name)}")
-            out.add(*_id_lines([f"{v:+d}" for v in values]))
-        self._model_lists(out, region_of, tface_of, blocks)
-        out.add("END")  # unparsed header lines were reported on reading and are not written
-        pieces = [out.text()]
-        model_name = {int(s.id or 0): n for s, n in zip(surfaces, names, strict=True)}
-        for surface in scene.surfaces:  # scene order; surfaces outside the model too
-            # a TSolid's SURFACEs too: the TSolid itself is not written in a Model3d
-            member = model_name.get(int(surface.id or 0))
-            extra = (("name_in_model_list", member),) if member is not None else ()
-            pieces.append(self.tsurf(surface, extra, tface_type.get(int(surface.id or 0))))
-        skipped = [e.label for e in scene.entities if not isinstance(e, Surface | Block)]
-        if skipped:
-            report(f"a Model3d holds surfaces and regions only; not written: {', '.join(skipped)}")
-        return b"".join(pieces)
+        return ordered
 
     def _model_lists(
         self,
@@ -546,7 +516,7 @@ class _Writer:
             out.add(f"TYPE {meta['member_type']}")
         out.add("BEGIN_MEMBERS")
         pieces = [out.text()]
-        items: list[tuple[int, Any]] = [(m, m) for m in group.members]
+        items: list[tuple[int, int | Group]] = [(m, m) for m in group.members]
         for child in group.children:
             ids = [m for g in child.walk() for m in g.members]
             items.append((min(ids) if ids else 1 << 62, child))
@@ -571,7 +541,7 @@ class _BorderPlaces:
         surface: Surface,
         tolerance: float,
         corner_points: list[NDArray[np.float64]],
-        arcs: list[Any],
+        arcs: list[Arc],
     ) -> None:
         from scipy.spatial import cKDTree
 
@@ -632,6 +602,68 @@ class _BorderPlaces:
                 borders.append(pair)
         bstones = set(np.flatnonzero(self.is_corner).tolist()) | {a for a, _ in borders}
         return sorted(bstones), borders
+
+
+class _TFaceLines:
+    """Writes a Model3d header's TFACE lines and remembers what each patch became."""
+
+    def __init__(
+        self, patch_of: dict[tuple[int, int], Patch], name_of: dict[int, str], z_sign: float
+    ) -> None:
+        self.patch_of = patch_of
+        self.name_of = name_of
+        self.z_sign = z_sign
+        self.tface_of: dict[int, int] = {}  # patch id -> TFACE number
+        self.flipped: dict[int, bool] = {}  # patch id -> key triangle written reversed
+        self.type_of: dict[int, str] = {}  # surface id -> geological type of its first TFACE
+
+    def add(self, out: ObjectText, number: int, surface: Surface, label: int) -> None:
+        """``TFACE <number> <type> <TSurf>`` and its key triangle (z as the CRS wants it)."""
+        sid = int(surface.id or 0)
+        patch = self.patch_of.get((sid, label))
+        pmeta = gocad_section(patch.metadata) if patch is not None else {}
+        geo_type = pmeta.get("geological_type") or _surface_type(surface)
+        self.type_of.setdefault(sid, str(geo_type))
+        out.add(f"TFACE {number}  {geo_type} {quote_rest(self.name_of[sid])}")
+        faces = surface.patch_faces(label)  # never empty: empty patches are not written
+        key = pmeta.get("key_triangle")
+        if not (isinstance(key, int) and key in set(faces.tolist())):
+            key = int(faces[0])
+        corners = np.array(surface.vertices[surface.faces[key][:3]], dtype=np.float64)
+        reverse = bool(pmeta.get("key_reversed"))
+        if reverse:
+            corners = corners[::-1]
+        corners[:, 2] *= self.z_sign
+        for point in corners.tolist():
+            out.add("  " + " ".join(format_float(c) for c in point))
+        if patch is not None:
+            self.tface_of[patch.id] = number
+            self.flipped[patch.id] = reverse
+
+
+def _region_ids(blocks: list[Block], first_region: int) -> dict[int, int]:
+    """REGION id of each block (by block id): the source's when still valid, else numbered
+    after the TFACEs."""
+    region_of = {int(b.id or 0): first_region + offset for offset, b in enumerate(blocks)}
+    kept = [gocad_metadata(b).get("region_id") for b in blocks]
+    valid = [k for k in kept if isinstance(k, int) and k >= first_region]
+    if len(valid) == len(kept) and len(set(valid)) == len(valid):
+        region_of = {int(b.id or 0): k for b, k in zip(blocks, valid, strict=True)}
+    return region_of
+
+
+def _region_lines(out: ObjectText, block: Block, region_id: int, tfaces: _TFaceLines) -> None:
+    """``REGION <id> <name>`` and its signed TFACE numbers."""
+    values = []
+    for patch_id, side in block.sides:
+        if patch_id not in tfaces.tface_of:
+            report(f"{block.label}: patch {patch_id} has no TFACE; left out of its REGION")
+            continue
+        sign = -side if tfaces.flipped.get(patch_id) else side
+        values.append(sign * tfaces.tface_of[patch_id])
+    name = "Universe" if block.is_universe else (block.name or f"region_{block.id}")
+    out.add(f"REGION {region_id}  {quote_rest(name)}")
+    out.add(*_id_lines([f"{v:+d}" for v in values]))
 
 
 def _written_labels(surface: Surface) -> NDArray[np.int64]:
