@@ -15,13 +15,14 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass
 
 import numpy as np
 
 from geobrep import Scene, Surface
 from geobrep.errors import OptionsError, TopologyError
 from geobrep.plugins.blocks.arcs import ArcChains, chain_arcs
-from geobrep.plugins.blocks.assembly import assemble
+from geobrep.plugins.blocks.assembly import Assembly, assemble
 from geobrep.plugins.blocks.conformity import check_conformity
 from geobrep.plugins.blocks.dangling import (
     DanglingPatch,
@@ -29,15 +30,15 @@ from geobrep.plugins.blocks.dangling import (
     free_border_arcs,
     free_border_patches,
 )
-from geobrep.plugins.blocks.measures import measure_patches
+from geobrep.plugins.blocks.measures import PatchMeasures, measure_patches
 from geobrep.plugins.blocks.options import BlockBuilderOptions
 from geobrep.plugins.blocks.patches import PatchSplit, split_patches
-from geobrep.plugins.blocks.radial_sort import sort_arcs
+from geobrep.plugins.blocks.radial_sort import SortedArcs, sort_arcs
 from geobrep.plugins.blocks.report import REPORT_KEY, BlockReport, DanglingEntry
 from geobrep.plugins.blocks.soup import Soup, build_soup
 from geobrep.plugins.blocks.traversal import traverse
-from geobrep.plugins.blocks.universe import find_universe
-from geobrep.plugins.blocks.validation import validate_scene
+from geobrep.plugins.blocks.universe import Bodies, find_universe
+from geobrep.plugins.blocks.validation import Validation, validate_scene
 
 __all__ = ["build_blocks"]
 
@@ -109,76 +110,185 @@ def build_blocks(scene: Scene, options: BlockBuilderOptions) -> Scene:
     surfaces = _select_surfaces(scene, options.surfaces)
     with watch.stage("soup"):
         soup = build_soup(surfaces, options.tolerance, options.relative_tolerance)
-    n_input = soup.n_triangles
     gap_tolerance = (
         options.gap_tolerance
         if options.gap_tolerance is not None
         else options.relative_gap_tolerance * soup.diagonal
     )
+    topology = _closed_topology(soup, options, gap_tolerance, watch)
+    with watch.stage("assembly"):
+        assembly = assemble(
+            scene,
+            topology.soup,
+            topology.split,
+            topology.chains,
+            topology.arcs,
+            topology.bodies,
+            topology.measures,
+        )
+    validation = None
+    if options.validate_blocks:
+        with watch.stage("validation"):
+            validation = validate_scene(
+                assembly.scene,
+                topology.soup,
+                topology.split,
+                topology.measures,
+                assembly.vertex_ids,
+            )
+    report = _report(
+        (len(surfaces), soup.n_triangles), gap_tolerance, watch, topology, assembly, validation
+    )
+    built = assembly.scene
+    metadata = {**built.metadata, REPORT_KEY: report.model_dump(mode="json")}
+    return built.replace(metadata=metadata)
+
+
+@dataclass(frozen=True)
+class _Topology:
+    """The last pass over the soup: every stage's result, what was removed, how many passes."""
+
+    soup: Soup
+    split: PatchSplit
+    chains: ArcChains
+    arcs: SortedArcs
+    bodies: Bodies
+    measures: PatchMeasures
+    removed: list[DanglingPatch]
+    passes: int
+
+
+def _closed_topology(
+    soup: Soup, options: BlockBuilderOptions, gap_tolerance: float, watch: _Stopwatch
+) -> _Topology:
+    """Run the stages until no patch dangles (each pass removes the dangling ones)."""
     removed: list[DanglingPatch] = []
     open_border = ""  # the first free borders found, named if nothing closed is left
     passes = 0
     while True:
         passes += 1
         if soup.n_triangles == 0:
-            where = f": the model is open, {open_border}" if open_border else ""
-            raise TopologyError(
-                "no closed block: every patch was dangling "
-                f"({len(removed)} removed; the surfaces enclose no volume){where}"
+            raise _no_closed_block(
+                f"every patch was dangling ({len(removed)} removed; the surfaces enclose no "
+                "volume)",
+                open_border,
             )
         with watch.stage("patches"):
             split = split_patches(soup)
         with watch.stage("arcs"):
             chains = chain_arcs(split, soup.vertices.shape[0], soup.vertices)
-        if passes == 1 and free_border_arcs(split, chains).size:
-            open_border = str(_free_border_error(soup, split, chains))
-        if passes == 1 and options.check_conformity:
-            with watch.stage("conformity"):
-                check_conformity(soup, split, gap_tolerance)
-        if options.free_borders != "internal":
-            with watch.stage("dangling"):
-                free = free_border_patches(split, chains)
-                if free.size and options.free_borders == "error":
-                    raise _free_border_error(soup, split, chains)
-                if free.size:
-                    removed += describe_dangling(soup, split, free, "free border")
-                    soup = soup.subset(~np.isin(split.triangle_patch, free))
-            if free.size:
-                continue
-        with watch.stage("sort"):
-            arcs = sort_arcs(
-                soup.vertices,
-                soup.triangles,
-                split,
-                chains,
-                options.angle_tolerance,
-                _describe_patch(soup, split),
-            )
-        with watch.stage("traversal"):
-            regions = traverse(arcs.around, split.n_patches)
-        with watch.stage("universe"):
-            measures = measure_patches(soup, split)
-            bodies = find_universe(soup, split, regions, measures)
-        dangling = bodies.dangling
-        if dangling.size:
-            with watch.stage("dangling"):
-                removed += describe_dangling(soup, split, bodies.outside, "outside the model")
-                removed += describe_dangling(soup, split, bodies.floating, "bounds no volume")
-                soup = soup.subset(~np.isin(split.triangle_patch, dangling))
-            continue
-        break
-    if bodies.universe < 0 or bodies.n_bodies < 2:
-        where = f": the model is open, {open_border}" if open_border else ""
-        raise TopologyError(f"no closed block: the surfaces enclose no volume{where}")
-    with watch.stage("assembly"):
-        assembly = assemble(scene, soup, split, chains, arcs, bodies, measures)
+        if passes == 1:
+            open_border = _first_pass_checks(soup, split, chains, options, gap_tolerance, watch)
+        smaller = _without_free_borders(soup, split, chains, options, watch, removed)
+        if smaller is None:
+            arcs, bodies, measures = _bodies(soup, split, chains, options, watch)
+            smaller = _without_dangling(soup, split, bodies, watch, removed)
+            if smaller is None:
+                if bodies.universe < 0 or bodies.n_bodies < 2:
+                    raise _no_closed_block("the surfaces enclose no volume", open_border)
+                return _Topology(soup, split, chains, arcs, bodies, measures, removed, passes)
+        soup = smaller
+
+
+def _no_closed_block(reason: str, open_border: str) -> TopologyError:
+    where = f": the model is open, {open_border}" if open_border else ""
+    return TopologyError(f"no closed block: {reason}{where}")
+
+
+def _first_pass_checks(
+    soup: Soup,
+    split: PatchSplit,
+    chains: ArcChains,
+    options: BlockBuilderOptions,
+    gap_tolerance: float,
+    watch: _Stopwatch,
+) -> str:
+    """The free borders of the input in words (or ``""``); non-conformal input raises."""
+    open_border = ""
+    if free_border_arcs(split, chains).size:
+        open_border = str(_free_border_error(soup, split, chains))
+    if options.check_conformity:
+        with watch.stage("conformity"):
+            check_conformity(soup, split, gap_tolerance)
+    return open_border
+
+
+def _without_free_borders(
+    soup: Soup,
+    split: PatchSplit,
+    chains: ArcChains,
+    options: BlockBuilderOptions,
+    watch: _Stopwatch,
+    removed: list[DanglingPatch],
+) -> Soup | None:
+    """The soup without the patches on free borders (``None``: none to remove), per options."""
+    if options.free_borders == "internal":
+        return None
+    with watch.stage("dangling"):
+        free = free_border_patches(split, chains)
+        if free.size and options.free_borders == "error":
+            raise _free_border_error(soup, split, chains)
+        if not free.size:
+            return None
+        removed += describe_dangling(soup, split, free, "free border")
+        return soup.subset(~np.isin(split.triangle_patch, free))
+
+
+def _bodies(
+    soup: Soup,
+    split: PatchSplit,
+    chains: ArcChains,
+    options: BlockBuilderOptions,
+    watch: _Stopwatch,
+) -> tuple[SortedArcs, Bodies, PatchMeasures]:
+    """Patches sorted around the arcs, regions traversed, the universe and the bodies found."""
+    with watch.stage("sort"):
+        arcs = sort_arcs(
+            soup.vertices,
+            soup.triangles,
+            split,
+            chains,
+            options.angle_tolerance,
+            _describe_patch(soup, split),
+        )
+    with watch.stage("traversal"):
+        regions = traverse(arcs.around, split.n_patches)
+    with watch.stage("universe"):
+        measures = measure_patches(soup, split)
+        bodies = find_universe(soup, split, regions, measures)
+    return arcs, bodies, measures
+
+
+def _without_dangling(
+    soup: Soup,
+    split: PatchSplit,
+    bodies: Bodies,
+    watch: _Stopwatch,
+    removed: list[DanglingPatch],
+) -> Soup | None:
+    """The soup without the patches outside the model or bounding no volume (``None``: none)."""
+    if not bodies.dangling.size:
+        return None
+    with watch.stage("dangling"):
+        removed += describe_dangling(soup, split, bodies.outside, "outside the model")
+        removed += describe_dangling(soup, split, bodies.floating, "bounds no volume")
+        return soup.subset(~np.isin(split.triangle_patch, bodies.dangling))
+
+
+def _report(
+    inputs: tuple[int, int],
+    gap_tolerance: float,
+    watch: _Stopwatch,
+    topology: _Topology,
+    assembly: Assembly,
+    validation: Validation | None,
+) -> BlockReport:
+    """The builder's report: ``inputs`` are the numbers of input surfaces and triangles."""
+    n_surfaces, n_input = inputs
+    soup, split, chains, arcs = topology.soup, topology.split, topology.chains, topology.arcs
     built = assembly.scene
-    validation = None
-    if options.validate_blocks:
-        with watch.stage("validation"):
-            validation = validate_scene(built, soup, split, measures, assembly.vertex_ids)
-    report = BlockReport(
-        surfaces=len(surfaces),
+    return BlockReport(
+        surfaces=n_surfaces,
         triangles=n_input,
         vertices=int(soup.vertices.shape[0]),
         merged_vertices=soup.merged_vertices,
@@ -189,13 +299,13 @@ def build_blocks(scene: Scene, options: BlockBuilderOptions) -> Scene:
         corners=int(chains.corners.shape[0]),
         blocks=len(built.blocks),
         internal_patches=assembly.internal_patches,
-        dangling=[DanglingEntry(**vars(entry)) for entry in removed],
+        dangling=[DanglingEntry(**vars(entry)) for entry in topology.removed],
         removed_surfaces=assembly.removed_surfaces,
-        nested_bodies=bodies.nested_components,
+        nested_bodies=topology.bodies.nested_components,
         direction_triangles=arcs.touched_triangles,
         sorted_share=arcs.touched_triangles / max(n_input, 1),
         retried_arcs=arcs.retried_arcs,
-        passes=passes,
+        passes=topology.passes,
         tolerance=soup.tolerance,
         tolerance_source=soup.tolerance_source,
         precision=soup.precision.quantum if soup.precision else None,
@@ -208,5 +318,3 @@ def build_blocks(scene: Scene, options: BlockBuilderOptions) -> Scene:
         volume_balance=validation.volume_balance if validation else None,
         adjacency=built.block_adjacency(),
     )
-    metadata = {**built.metadata, REPORT_KEY: report.model_dump(mode="json")}
-    return built.replace(metadata=metadata)

@@ -6,7 +6,8 @@ context)``; see ``docs/clipping.md``. Each clipper lives in its own module of th
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from geobrep.plugins import hookimpl
 
@@ -36,81 +37,34 @@ def geobrep_register_clippers(registry: ClipperRegistry) -> None:
     from geobrep.plugins.clip.polygons import clip_polygon, section_polygon
     from geobrep.plugins.clip.surfaces import clip_surface, section_surface
 
-    registry.add(
-        ClipperSpec(
-            name="surface",
-            description="Triangle and quad surfaces: shared cut vertices, interpolated point "
-            "data, caps on closed surfaces",
-            entity_type="Surface",
-            function=clip_surface,
-            section=section_surface,
-            options=SurfaceClipOptions,
+    # name, entity type, clipper, section (or None), options model, description
+    table: list[tuple[str, str, Callable[..., Any], Callable[..., Any] | None, type, str]] = [
+        ("surface", "Surface", clip_surface, section_surface, SurfaceClipOptions,
+         "Triangle and quad surfaces: shared cut vertices, interpolated point data, caps on "
+         "closed surfaces"),
+        ("polyline", "PolyLine", clip_polyline, section_polyline, ClipOptions,
+         "Lines: runs of kept segments become parts, crossing points exact"),
+        ("polygon", "Polygon", clip_polygon, section_polygon, ClipOptions,
+         "Filled polygons with holes: pieces closed along the cut, holes nested"),
+        ("pointset", "PointSet", clip_pointset, section_pointset, ClipOptions,
+         "Points: those on the kept side (on the plane: both sides)"),
+        ("annotation", "Annotation", clip_annotation, None, AnnotationClipOptions,
+         "Text at string, character or stroke precision (built-in stroke font)"),
+        ("octree", "LinearOctree", clip_octree, None, OctreeClipOptions,
+         "Linear octrees: leaves kept, dropped, or split down to the finest level"),
+        ("nurbs", "NurbsSurface", clip_nurbs, None, NurbsClipOptions,
+         "NURBS surfaces: exact trimming by half-spaces, found on the tessellation"),
+        ("block", "Block", clip_block, section_block, ClipOptions,
+         "Blocks of a scene: each cut block is closed by a cap patch"),
+    ]  # fmt: skip
+    for name, entity_type, function, section, options, description in table:
+        registry.add(
+            ClipperSpec(
+                name=name,
+                description=description,
+                entity_type=entity_type,
+                function=function,
+                section=section,
+                options=options,
+            )
         )
-    )
-    registry.add(
-        ClipperSpec(
-            name="polyline",
-            description="Lines: runs of kept segments become parts, crossing points exact",
-            entity_type="PolyLine",
-            function=clip_polyline,
-            section=section_polyline,
-            options=ClipOptions,
-        )
-    )
-    registry.add(
-        ClipperSpec(
-            name="polygon",
-            description="Filled polygons with holes: pieces closed along the cut, holes nested",
-            entity_type="Polygon",
-            function=clip_polygon,
-            section=section_polygon,
-            options=ClipOptions,
-        )
-    )
-    registry.add(
-        ClipperSpec(
-            name="pointset",
-            description="Points: those on the kept side (on the plane: both sides)",
-            entity_type="PointSet",
-            function=clip_pointset,
-            section=section_pointset,
-            options=ClipOptions,
-        )
-    )
-    registry.add(
-        ClipperSpec(
-            name="annotation",
-            description="Text at string, character or stroke precision (built-in stroke font)",
-            entity_type="Annotation",
-            function=clip_annotation,
-            options=AnnotationClipOptions,
-        )
-    )
-    registry.add(
-        ClipperSpec(
-            name="octree",
-            description="Linear octrees: leaves kept, dropped, or split down to the finest level",
-            entity_type="LinearOctree",
-            function=clip_octree,
-            options=OctreeClipOptions,
-        )
-    )
-    registry.add(
-        ClipperSpec(
-            name="nurbs",
-            description="NURBS surfaces: exact trimming by half-spaces, found on the tessellation",
-            entity_type="NurbsSurface",
-            function=clip_nurbs,
-            options=NurbsClipOptions,
-        )
-    )
-    registry.add(
-        ClipperSpec(
-            name="block",
-            description="Blocks of a scene: each cut block is closed by a cap patch",
-            entity_type="Block",
-            function=clip_block,
-            section=section_block,
-            options=ClipOptions,
-        )
-    )

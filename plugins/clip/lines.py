@@ -77,99 +77,208 @@ def cut_segments(
     >>> cut.vertices.tolist(), cut.indices.tolist()
     ([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [0, 1])
     """
-    n = vertices.shape[0]
     sides = vertex_sides(distances, tolerance)
-    s0, s1 = sides[segments[:, 0]], sides[segments[:, 1]]
-    ok0, ok1 = (s0 == side) | (s0 == 0), (s1 == side) | (s1 == 0)
-    whole = ok0 & ok1
-    crossing = (s0 * s1) < 0
-    cut_rows = np.flatnonzero(crossing)
-    points, edge_a, edge_b, edge_t = crossing_points(
-        vertices, distances, segments[cut_rows, 0], segments[cut_rows, 1]
+    pieces = _kept_pieces(vertices, segments, segment_chain, sides, distances, side)
+    chains = _ChainRows.of(segment_chain, chain_closed)
+    run_of_piece, order_in_chain = _runs_of_pieces(pieces, chains)
+    runs = _ordered_runs(pieces, chains, run_of_piece, order_in_chain)
+    return _line_cut(vertices, sides, pieces, runs)
+
+
+@dataclass(frozen=True)
+class _Pieces:
+    """What each segment keeps on one side: the segment whole, or its kept end and a crossing.
+
+    ``segment`` is the input segment of each piece (increasing); ``start`` and ``end`` its points,
+    crossing point ``k`` numbered ``n_vertices + k``; ``whole`` flags every *input* segment
+    that is kept whole; ``crossings`` are the crossing points of the cut segments, on the edges
+    ``(edge_a, edge_b)`` at ``edge_t``.
+    """
+
+    segment: IntArray
+    start: IntArray
+    end: IntArray
+    chain: IntArray
+    whole: BoolArray
+    crossings: FloatArray
+    edge_a: IntArray
+    edge_b: IntArray
+    edge_t: FloatArray
+
+
+def _kept_pieces(
+    vertices: FloatArray,
+    segments: IntArray,
+    segment_chain: IntArray,
+    sides: NDArray[np.int8],
+    distances: FloatArray,
+    side: int,
+) -> _Pieces:
+    """The segments kept whole and the kept halves of the cut ones, in input order."""
+    start_side, end_side = sides[segments[:, 0]], sides[segments[:, 1]]
+    start_kept = (start_side == side) | (start_side == 0)
+    end_kept = (end_side == side) | (end_side == 0)
+    whole = start_kept & end_kept
+    crossing = (start_side * end_side) < 0
+    cut = np.flatnonzero(crossing)
+    crossings, edge_a, edge_b, edge_t = crossing_points(
+        vertices, distances, segments[cut, 0], segments[cut, 1]
     )
     starts = segments[:, 0].copy()
     ends = segments[:, 1].copy()
-    new_id = n + np.arange(cut_rows.shape[0], dtype=np.int64)
-    start_kept = s0[cut_rows] == side
-    ends[cut_rows[start_kept]] = new_id[start_kept]
-    starts[cut_rows[~start_kept]] = new_id[~start_kept]
-    rows = np.flatnonzero(whole | crossing)
-    p, q, chain = starts[rows], ends[rows], segment_chain[rows]
-    joins = np.zeros(rows.shape[0], dtype=np.bool_)
-    if rows.shape[0] > 1:
-        joins[1:] = (chain[1:] == chain[:-1]) & (rows[1:] == rows[:-1] + 1) & (q[:-1] == p[1:])
-    # A closed chain cut somewhere: its last run continues into its first.
-    counts = np.bincount(segment_chain, minlength=chain_closed.shape[0])
-    first_row = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    last_row = first_row + counts - 1
-    order_key = rows.copy()
-    run_id = np.cumsum(~joins) - 1
-    if rows.shape[0]:
-        run_first = np.flatnonzero(~joins)
-        run_last = np.append(run_first[1:] - 1, rows.shape[0] - 1)
-        first_chain = chain[run_first]
-        wraps = (
-            chain_closed[first_chain]
-            & (rows[run_last] == last_row[first_chain])
-            & (rows[run_first] != first_row[first_chain])
+    crossing_id = vertices.shape[0] + np.arange(cut.shape[0], dtype=np.int64)
+    keeps_start = start_side[cut] == side
+    ends[cut[keeps_start]] = crossing_id[keeps_start]
+    starts[cut[~keeps_start]] = crossing_id[~keeps_start]
+    kept = np.flatnonzero(whole | crossing)
+    return _Pieces(
+        segment=kept,
+        start=starts[kept],
+        end=ends[kept],
+        chain=segment_chain[kept],
+        whole=whole,
+        crossings=crossings,
+        edge_a=edge_a,
+        edge_b=edge_b,
+        edge_t=edge_t,
+    )
+
+
+@dataclass(frozen=True)
+class _ChainRows:
+    """Per input chain: its segment count, first and last segment, and whether it is closed."""
+
+    count: IntArray
+    first: IntArray
+    last: IntArray
+    closed: BoolArray
+
+    @classmethod
+    def of(cls, segment_chain: IntArray, chain_closed: BoolArray) -> _ChainRows:
+        count = np.bincount(segment_chain, minlength=chain_closed.shape[0])
+        first = np.concatenate([[0], np.cumsum(count)[:-1]])
+        return cls(count=count, first=first, last=first + count - 1, closed=chain_closed)
+
+
+def _runs_of_pieces(pieces: _Pieces, chains: _ChainRows) -> tuple[IntArray, IntArray]:
+    """The run of every piece, and the key that orders the pieces of a chain.
+
+    Consecutive pieces of a chain that share a point form a run; the key is the input segment.
+    """
+    segment, start, end, chain = pieces.segment, pieces.start, pieces.end, pieces.chain
+    joins_previous = np.zeros(segment.shape[0], dtype=np.bool_)
+    if segment.shape[0] > 1:
+        joins_previous[1:] = (
+            (chain[1:] == chain[:-1]) & (segment[1:] == segment[:-1] + 1) & (end[:-1] == start[1:])
         )
-        # The run ending at the closing segment, followed by the run starting the chain.
-        head = np.flatnonzero(rows == first_row[chain])
-        head_run = np.full(chain_closed.shape[0], -1, dtype=np.int64)
-        head_run[chain[head]] = run_id[head]
-        for_runs = np.flatnonzero(wraps)
-        targets = head_run[first_chain[for_runs]]
-        mergeable = (targets >= 0) & (targets != for_runs)
-        mergeable &= q[run_last[for_runs]] == p[run_first[np.maximum(targets, 0)]]
-        merges = zip(for_runs[mergeable].tolist(), targets[mergeable].tolist(), strict=True)
-        for run, target in merges:
-            members = run_id == run
-            order_key[members] = rows[members] - (last_row[chain[members]] + 1)
-            run_id[members] = target
-    order = np.lexsort((order_key, chain))
-    p, q, chain, run_id, source = p[order], q[order], chain[order], run_id[order], rows[order]
-    starts_run = np.ones(p.shape[0], dtype=np.bool_)
-    starts_run[1:] = run_id[1:] != run_id[:-1]
-    run_starts = np.flatnonzero(starts_run)
-    run_lengths = np.diff(np.append(run_starts, p.shape[0]))
+    run_of_piece = np.cumsum(~joins_previous) - 1
+    order_in_chain = segment.copy()
+    if segment.shape[0]:
+        _wrap_closed_chains(pieces, chains, joins_previous, run_of_piece, order_in_chain)
+    return run_of_piece, order_in_chain
+
+
+def _wrap_closed_chains(
+    pieces: _Pieces,
+    chains: _ChainRows,
+    joins_previous: BoolArray,
+    run_of_piece: IntArray,
+    order_in_chain: IntArray,
+) -> None:
+    """A closed chain cut somewhere: the run ending at its closing segment continues into the
+    run starting the chain (``run_of_piece`` and ``order_in_chain`` are updated in place)."""
+    segment, start, end, chain = pieces.segment, pieces.start, pieces.end, pieces.chain
+    run_first = np.flatnonzero(~joins_previous)  # first piece of every run
+    run_last = np.append(run_first[1:] - 1, segment.shape[0] - 1)
+    run_chain = chain[run_first]
+    wraps = (
+        chains.closed[run_chain]
+        & (segment[run_last] == chains.last[run_chain])
+        & (segment[run_first] != chains.first[run_chain])
+    )
+    heads = np.flatnonzero(segment == chains.first[chain])  # pieces that start their chain
+    head_run_of_chain = np.full(chains.closed.shape[0], -1, dtype=np.int64)
+    head_run_of_chain[chain[heads]] = run_of_piece[heads]
+    wrapping = np.flatnonzero(wraps)
+    head_runs = head_run_of_chain[run_chain[wrapping]]
+    mergeable = (head_runs >= 0) & (head_runs != wrapping)
+    mergeable &= end[run_last[wrapping]] == start[run_first[np.maximum(head_runs, 0)]]
+    merges = zip(wrapping[mergeable].tolist(), head_runs[mergeable].tolist(), strict=True)
+    for run, head_run in merges:
+        members = run_of_piece == run
+        # before the head run's pieces: negative keys, in the chain's order
+        order_in_chain[members] = segment[members] - (chains.last[chain[members]] + 1)
+        run_of_piece[members] = head_run
+
+
+@dataclass(frozen=True)
+class _Runs:
+    """The runs as point sequences: run ``r`` visits ``sequence[offsets[r]:offsets[r+1]]``."""
+
+    sequence: IntArray
+    offsets: IntArray
+    closed: BoolArray
+    chain: IntArray
+    segment_source: IntArray
+
+
+def _ordered_runs(
+    pieces: _Pieces, chains: _ChainRows, run_of_piece: IntArray, order_in_chain: IntArray
+) -> _Runs:
+    """Pieces sorted into runs, each run's points (its first start, then every end; a whole
+    closed chain without the repeated first point)."""
+    order = np.lexsort((order_in_chain, pieces.chain))
+    start, end = pieces.start[order], pieces.end[order]
+    chain, run_of_piece, source = pieces.chain[order], run_of_piece[order], pieces.segment[order]
+    begins_run = np.ones(start.shape[0], dtype=np.bool_)
+    begins_run[1:] = run_of_piece[1:] != run_of_piece[:-1]
+    run_starts = np.flatnonzero(begins_run)
+    run_lengths = np.diff(np.append(run_starts, start.shape[0]))
     run_chain = chain[run_starts]
-    whole_count = (
-        np.add.reduceat(whole[source].astype(np.int64), run_starts)
+    whole_pieces = (
+        np.add.reduceat(pieces.whole[source].astype(np.int64), run_starts)
         if run_starts.shape[0]
         else np.zeros(0, dtype=np.int64)
     )
-    closed_run = (
-        chain_closed[run_chain] & (run_lengths == counts[run_chain]) & (whole_count == run_lengths)
+    closed = (
+        chains.closed[run_chain]
+        & (run_lengths == chains.count[run_chain])
+        & (whole_pieces == run_lengths)
     )
-    # Vertex sequence of each run: its first start, then every end (closed: no repeat).
-    sequence = np.insert(q, run_starts, p[run_starts])
+    sequence = np.insert(end, run_starts, start[run_starts])
     offsets = np.append(run_starts + np.arange(run_starts.shape[0]), sequence.shape[0])
-    drop_last = np.flatnonzero(closed_run)
-    if drop_last.shape[0]:
-        remove = offsets[drop_last + 1] - 1
-        sequence = np.delete(sequence, remove)
-        offsets = offsets - np.searchsorted(np.sort(remove), offsets, side="left")
-    used, local = np.unique(sequence, return_inverse=True)
-    kept_points = used[used < n]
-    new_points = used[used >= n] - n
-    out_vertices = np.concatenate([vertices[kept_points], points[new_points]])
+    closed_runs = np.flatnonzero(closed)
+    if closed_runs.shape[0]:
+        repeated = offsets[closed_runs + 1] - 1
+        sequence = np.delete(sequence, repeated)
+        offsets = offsets - np.searchsorted(np.sort(repeated), offsets, side="left")
+    return _Runs(sequence, offsets, closed, run_chain, source)
+
+
+def _line_cut(
+    vertices: FloatArray, sides: NDArray[np.int8], pieces: _Pieces, runs: _Runs
+) -> LineCut:
+    """The runs renumbered over the points they use: kept input points, then crossings."""
+    n_vertices = vertices.shape[0]
+    used, local = np.unique(runs.sequence, return_inverse=True)
+    kept_points = used[used < n_vertices]
+    new_points = used[used >= n_vertices] - n_vertices
+    out_vertices = np.concatenate([vertices[kept_points], pieces.crossings[new_points]])
     on_plane = np.concatenate([sides[kept_points] == 0, np.ones(new_points.shape[0], bool)])
     local = local.reshape(-1).astype(np.int64)
-    first_points = local[offsets[:-1]]
-    last_points = local[offsets[1:] - 1]
     return LineCut(
         vertices=out_vertices,
         kept_points=kept_points,
-        edge_a=edge_a[new_points],
-        edge_b=edge_b[new_points],
-        edge_t=edge_t[new_points],
+        edge_a=pieces.edge_a[new_points],
+        edge_b=pieces.edge_b[new_points],
+        edge_t=pieces.edge_t[new_points],
         indices=local,
-        offsets=offsets.astype(np.int64),
-        closed=closed_run,
-        source_chain=run_chain.astype(np.int64),
-        segment_source=source.astype(np.int64),
-        starts_on_plane=on_plane[first_points],
-        ends_on_plane=on_plane[last_points],
+        offsets=runs.offsets.astype(np.int64),
+        closed=runs.closed,
+        source_chain=runs.chain.astype(np.int64),
+        segment_source=runs.segment_source.astype(np.int64),
+        starts_on_plane=on_plane[local[runs.offsets[:-1]]],
+        ends_on_plane=on_plane[local[runs.offsets[1:] - 1]],
     )
 
 

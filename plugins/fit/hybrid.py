@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from geobrep import Entity, NurbsSurface
+from geobrep import Entity, NurbsSurface, PointSet
 from geobrep.errors import DegenerateGeometryError, OptionsError
 from geobrep.geometry.nurbs import NurbsNet, greville_abscissae, surface_points
 from geobrep.plugins import FitResult
@@ -99,14 +99,10 @@ def layout_knots(
 
 
 def _core_mask(
-    points: FloatArray, ab: FloatArray, options: HybridOptions, pointset: object
+    points: FloatArray, ab: FloatArray, options: HybridOptions, pointset: PointSet | None
 ) -> NDArray[np.bool_]:
-    from geobrep import PointSet
-
     if options.core_property is not None:
-        return core_by_property(
-            pointset if isinstance(pointset, PointSet) else None, options.core_property
-        )
+        return core_by_property(pointset, options.core_property)
     if options.core_polygon is not None:
         return inside_polygon(points[:, :2], np.asarray(options.core_polygon, dtype=np.float64))
     return core_by_density(ab)
@@ -312,8 +308,31 @@ def _regular_rows(rows: list[NDArray[np.int64]], ab: FloatArray, minimum: int) -
 def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
     """The ``hybrid`` fitter: skin the core, approximate the rim against it, report accuracy."""
     points, pointset = collect_points(entities, LABEL)
-    p, q = options.degree_u, options.degree_v
     frame = LocalFrame.from_points(points, LABEL)
+    core_mask = _checked_core_mask(points, frame, options, pointset)
+    core = _skinned_core(points, core_mask, frame, options)
+    fitted, layout = _fit_rim(core, options, int((~core_mask).sum()))
+    return _hybrid_result(points, pointset, core_mask, core, (fitted, layout), options)
+
+
+@dataclass(frozen=True)
+class _Core:
+    """The skinned core, in the frame turned to its rows, and the points grouped for the rim."""
+
+    frame: LocalFrame
+    local: FloatArray
+    """Every point in ``frame``."""
+    skinned: SkinnedNet
+    data: _Data
+    order: NDArray[np.int64]
+    """Input index of each point of ``data`` (skinned core, other core, rim)."""
+
+
+def _checked_core_mask(
+    points: FloatArray, frame: LocalFrame, options: HybridOptions, pointset: PointSet | None
+) -> NDArray[np.bool_]:
+    """The core points; a core too small to skin or an empty rim is an options error."""
+    p, q = options.degree_u, options.degree_v
     core_mask = _core_mask(points, frame.to_local(points)[:, :2], options, pointset)
     n_core, n_rim = int(core_mask.sum()), int((~core_mask).sum())
     if n_core < (p + 1) * (q + 1):
@@ -323,6 +342,14 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
         )
     if n_rim == 0:
         raise OptionsError(f"{LABEL}: every point is in the core; use method='skinning'")
+    return core_mask
+
+
+def _skinned_core(
+    points: FloatArray, core_mask: NDArray[np.bool_], frame: LocalFrame, options: HybridOptions
+) -> _Core:
+    """Skin the longest run of regular rows of the core; the other core rows become exact."""
+    p, q = options.degree_u, options.degree_v
     core_index = np.flatnonzero(core_mask)
     rows, angle = rows_from_lattice(frame.to_local(points[core_index])[:, :2], LABEL)
     frame = frame.rotated(angle)
@@ -337,8 +364,18 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
     rim_index = np.flatnonzero(~core_mask)
     order = np.concatenate([skinned_index, exact_index, rim_index])
     data = _Data(local[skinned_index], local[exact_index], local[rim_index])
-    core_net = skinned.net.control_points
-    outline = np.concatenate([local[:, :2], core_net[..., :2].reshape(-1, 2)])
+    return _Core(frame, local, skinned, data, order)
+
+
+_Rectangle = tuple[float, float, float, float]
+_Breaks = tuple[tuple[float, float], tuple[float, float]]
+
+
+def _rim_rectangle(core: _Core) -> tuple[_Rectangle, _Breaks, FloatArray]:
+    """The data rectangle ``(a0, a1, b0, b1)`` (2 % margin), the core's seams in it (0..1), and
+    the widths of the four rim sections (left, right, bottom, top)."""
+    core_net = core.skinned.net.control_points
+    outline = np.concatenate([core.local[:, :2], core_net[..., :2].reshape(-1, 2)])
     lo, hi = outline.min(axis=0), outline.max(axis=0)
     margin = 0.02 * float((hi - lo).max())
     a0, b0 = lo - margin
@@ -356,43 +393,65 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
     widths = np.array(
         [core_left - a0, a1 - core_right, core_bottom - b0, b1 - core_top], dtype=np.float64
     )
+    return rect, breaks, widths
+
+
+def _fit_rim(core: _Core, options: HybridOptions, n_rim: int) -> tuple[NetFit, Layout]:
+    """Approximate the rim against the fixed core, on finer rim nets until σ(rim) < ε."""
+    rect, breaks, widths = _rim_rectangle(core)
+    width, height = rect[1] - rect[0], rect[3] - rect[2]
+    core_net = core.skinned.net.control_points
     core_area = float(np.ptp(core_net[..., 0]) * np.ptp(core_net[..., 1]))
     rim_area = max(width * height - core_area, 0.25 * width * height)
     lam = smoothing_weight(options.smoothing, n_rim, width, height)
-    rim_rows = slice(skinned_index.size + exact_index.size, None)
+    rim_rows = slice(core.data.skinned.shape[0] + core.data.exact.shape[0], None)
     best: tuple[NetFit, Layout] | None = None
     for number, spans in enumerate(_rim_levels(widths, rim_area, n_rim, options), 1):
-        fitted, layout = _fit_level(skinned, spans, data, rect, breaks, lam)
+        fitted, layout = _fit_level(core.skinned, spans, core.data, rect, breaks, lam)
         fitted.details["nets_tried"] = number
         best = (fitted, layout)
         if options.epsilon is not None and sigma(fitted.residuals[rim_rows]) < options.epsilon:
             break
     assert best is not None
+    return best
+
+
+def _hybrid_result(
+    points: FloatArray,
+    pointset: PointSet | None,
+    core_mask: NDArray[np.bool_],
+    core: _Core,
+    best: tuple[NetFit, Layout],
+    options: HybridOptions,
+) -> FitResult:
+    """The world surface, its distances to every point and the report (overall, core, rim)."""
     fitted, layout = best
     kind = pointset.kind if pointset is not None else None
-    surface = nurbs_from_local(fitted, frame, "hybrid", kind)
+    surface = nurbs_from_local(fitted, core.frame, "hybrid", kind)
+    core_net = core.skinned.net
     core_surface = NurbsSurface(
-        degree_u=p,
-        degree_v=q,
-        knots_u=skinned.net.knots_u,
-        knots_v=skinned.net.knots_v,
-        control_points=frame.to_world(core_net.reshape(-1, 3)).reshape(core_net.shape),
-        weights=np.ones(core_net.shape[:2]),
+        degree_u=core_net.degree_u,
+        degree_v=core_net.degree_v,
+        knots_u=core_net.knots_u,
+        knots_v=core_net.knots_v,
+        control_points=core.frame.to_world(core_net.control_points.reshape(-1, 3)).reshape(
+            core_net.control_points.shape
+        ),
+        weights=np.ones(core_net.shape),
         name="hybrid core",
     )
     gap = seam_gap(surface, core_surface, layout)
-    inverse = np.empty_like(order)
-    inverse[order] = np.arange(order.shape[0])
+    inverse = np.empty_like(core.order)
+    inverse[core.order] = np.arange(core.order.shape[0])
     distances = surface_distances(surface, points, fitted.u[inverse], fitted.v[inverse])
-    labels = np.where(core_mask, "core", "rim")
     notes = list(fitted.notes)
     rim_sigma = sigma(distances[~core_mask])
     if options.epsilon is not None and not rim_sigma < options.epsilon:
         nu, nv = fitted.net.shape
         notes.append(
             f"ε = {options.epsilon:g} cannot be met on the rim: σ = {rim_sigma:.4g} with the "
-            f"finest rim net the data support ({nu} × {nv} control points overall for {n_rim} "
-            "rim points)"
+            f"finest rim net the data support ({nu} × {nv} control points overall for "
+            f"{int((~core_mask).sum())} rim points)"
         )
     report = accuracy_report(
         distances,
@@ -400,7 +459,7 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
         epsilon=options.epsilon,
         method="hybrid",
         subsets={"core": core_mask, "rim": ~core_mask},
-        labels=labels,
+        labels=np.where(core_mask, "core", "rim"),
         seam_gap=gap,
         notes=notes,
         details=fitted.details,

@@ -32,6 +32,8 @@ CHUNK_CANDIDATES = 1 << 20
 LATTICE_BITS = 29
 #: Triangles whose pixel box is at most this many pixels on a side are tested as regular blocks.
 SMALL_BOX = 4
+#: Pixels, depths and entering flags of some crossings.
+_Crossings = tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]
 
 
 @dataclass(frozen=True)
@@ -211,14 +213,28 @@ def ray_crossings(
         n,
     )
 
-    pieces: list[tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]] = []
-    # Small bounding boxes (most triangles of a fine mesh): one regular block per shape.
-    small = (
-        (tri.width_u <= SMALL_BOX)
-        & (tri.width_v <= SMALL_BOX)
-        & (tri.width_u > 0)
-        & (tri.width_v > 0)
+    boxed = (tri.width_u > 0) & (tri.width_v > 0)
+    small = (tri.width_u <= SMALL_BOX) & (tri.width_v <= SMALL_BOX) & boxed
+    pieces = _small_box_crossings(tri, small, half, n)
+    pieces += _large_box_crossings(tri, np.flatnonzero(~small & boxed), half, n)
+    if not pieces:
+        return RayCrossings(
+            axis, n, np.zeros(0, np.int64), np.zeros(0, np.float64), np.zeros(0, np.bool_)
+        )
+    return RayCrossings(
+        axis,
+        n,
+        np.concatenate([piece[0] for piece in pieces]),
+        np.concatenate([piece[1] for piece in pieces]),
+        np.concatenate([piece[2] for piece in pieces]),
     )
+
+
+def _small_box_crossings(
+    tri: _Triangles, small: NDArray[np.bool_], half: int, n: int
+) -> list[_Crossings]:
+    """Triangles with small pixel boxes (most of a fine mesh): one regular block per box shape."""
+    pieces: list[_Crossings] = []
     shape_key = np.where(small, (tri.width_u - 1) * SMALL_BOX + tri.width_v - 1, -1)
     for wu in range(1, SMALL_BOX + 1):
         for wv in range(1, SMALL_BOX + 1):
@@ -230,8 +246,14 @@ def ray_crossings(
             p = np.take(tri.first_u, rows)[:, None] + du
             q = np.take(tri.first_v, rows)[:, None] + dv
             pieces.append(_covered(tri, rows, p, q, half, n))
-    # Larger boxes: candidate pixels listed one by one, in chunks of bounded size.
-    large = np.flatnonzero(~small & (tri.width_u > 0) & (tri.width_v > 0))
+    return pieces
+
+
+def _large_box_crossings(
+    tri: _Triangles, large: NDArray[np.int64], half: int, n: int
+) -> list[_Crossings]:
+    """Triangles with larger boxes: candidate pixels listed one by one, in bounded chunks."""
+    pieces: list[_Crossings] = []
     counts = np.take(tri.width_u, large) * np.take(tri.width_v, large)
     ends = np.cumsum(counts)
     begin = 0
@@ -249,14 +271,4 @@ def ray_crossings(
         q = np.take(tri.first_v, owner) + offset % v_width
         pieces.append(_covered(tri, owner, p, q, half, n))
         begin = stop
-    if not pieces:
-        return RayCrossings(
-            axis, n, np.zeros(0, np.int64), np.zeros(0, np.float64), np.zeros(0, np.bool_)
-        )
-    return RayCrossings(
-        axis,
-        n,
-        np.concatenate([piece[0] for piece in pieces]),
-        np.concatenate([piece[1] for piece in pieces]),
-        np.concatenate([piece[2] for piece in pieces]),
-    )
+    return pieces
