@@ -178,3 +178,19 @@ def test_the_plugin_surface_exports_what_plugins_need() -> None:
         "FormatError",
     }
     assert needed <= set(surface.__all__)
+
+
+@pytest.mark.parametrize("path", _core_modules(), ids=lambda p: str(p.relative_to(CORE)))
+def test_core_imports_no_plugin_or_adapter_by_name(path: Path) -> None:
+    """Not even through ``importlib.import_module("geobrep.adapters...")``."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    calls = [
+        node
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Call)
+        and ast.unparse(node.func).endswith(("import_module", "__import__"))
+        and node.args
+        and isinstance(node.args[0], ast.Constant)
+        and str(node.args[0].value).startswith(("geobrep.adapters", "geobrep.plugins."))
+    ]
+    assert not calls, f"{path.relative_to(CORE)} imports {ast.unparse(calls[0].args[0])}"
