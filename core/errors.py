@@ -21,8 +21,10 @@ Third-party exceptions are translated where geobrep calls into a library, with
 
 from __future__ import annotations
 
+import importlib
 from os import PathLike
 from pathlib import Path
+from typing import Any
 
 __all__ = [
     "DegenerateGeometryError",
@@ -36,6 +38,7 @@ __all__ = [
     "PluginError",
     "TopologyError",
     "UnknownFormatError",
+    "import_optional",
 ]
 
 
@@ -118,3 +121,20 @@ class MissingDependencyError(GeobrepError, ImportError):
         super().__init__(
             f"{feature} needs the optional package '{package}': pip install 'geobrep[{extra}]'"
         )
+
+
+def import_optional(package: str, extra: str, feature: str) -> Any:
+    """The module ``package``, or :class:`MissingDependencyError`: ``feature`` needs ``extra``.
+
+    >>> import_optional("json", "none", "reading JSON").dumps([1])
+    '[1]'
+    >>> import_optional("no_such_package", "gis", "map products")
+    Traceback (most recent call last):
+    ...
+    geobrep.errors.MissingDependencyError: map products needs the optional package \
+'no_such_package': pip install 'geobrep[gis]'
+    """
+    try:
+        return importlib.import_module(package)
+    except ImportError as exc:
+        raise MissingDependencyError(package, extra, feature) from exc

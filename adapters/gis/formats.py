@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from pydantic import ConfigDict
 
 from geobrep.adapters._file_format import full_capabilities
-from geobrep.errors import FormatError, MissingDependencyError
+from geobrep.errors import FormatError, import_optional
 from geobrep.gis.feature_tables import (
     RESERVED_COLUMNS,
     FeatureTable,
@@ -66,11 +66,8 @@ class GisOptions(ReadOptions):
 
 
 def _pyogrio() -> Any:
-    try:
-        pyogrio = importlib.import_module("pyogrio")  # untyped: kept Any
-        importlib.import_module("pyogrio.raw")
-    except ImportError as exc:  # pragma: no cover - exercised only without the extra
-        raise MissingDependencyError("pyogrio", "gis", "GIS formats") from exc
+    pyogrio = import_optional("pyogrio", "gis", "GIS formats")
+    importlib.import_module("pyogrio.raw")  # part of pyogrio: its writer
     # GDAL would leave a ".aux.xml" beside files it only read: GeoPackage keeps its metadata inside
     pyogrio.set_gdal_config_options({"GDAL_PAM_ENABLED": "NO"})
     return pyogrio

@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.cell_layout import chain_segments
-from geobrep.errors import FormatError, MissingDependencyError
+from geobrep.errors import FormatError, import_optional
 from geobrep.geometry.morton import morton_decode, morton_encode
 from geobrep.model.entities import Entity, LinearOctree, PointSet, PolyLine, Surface
 from geobrep.model.properties import PropertyMap
@@ -41,11 +41,7 @@ class Open3dLossWarning(UserWarning):
 
 
 def _open3d() -> Any:
-    try:
-        import open3d
-    except ImportError as exc:
-        raise MissingDependencyError("open3d", "open3d", "the open3d bridge") from exc
-    return open3d
+    return import_optional("open3d", "open3d", "the open3d bridge")
 
 
 def _vector3(prop: Any) -> bool:

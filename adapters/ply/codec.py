@@ -11,7 +11,6 @@ point set) keeping all vertices and every vertex and face property under its PLY
 
 from __future__ import annotations
 
-import importlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Final
@@ -26,7 +25,7 @@ from geobrep.adapters.cell_layout import (
     layout_to_scene,
     scene_to_layout,
 )
-from geobrep.errors import FormatError, MissingDependencyError
+from geobrep.errors import FormatError, import_optional
 from geobrep.model.entities import PointSet, PolyLine, Surface
 from geobrep.model.properties import PropertyMap
 from geobrep.model.scene import Scene
@@ -41,11 +40,7 @@ _RESERVED: Final = frozenset({"x", "y", "z", "vertex1", "vertex2", *_INDEX_NAMES
 
 
 def _plyfile() -> Any:
-    try:
-        plyfile = importlib.import_module("plyfile")
-    except ImportError as exc:
-        raise MissingDependencyError("plyfile", "ply", "reading and writing PLY files") from exc
-    return plyfile
+    return import_optional("plyfile", "ply", "reading and writing PLY files")
 
 
 def _storable(values: NDArray[Any]) -> NDArray[Any]:

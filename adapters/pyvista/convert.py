@@ -27,7 +27,7 @@ from geobrep.adapters.cell_layout import (
     layout_to_scene,
     scene_to_layout,
 )
-from geobrep.errors import FormatError, MissingDependencyError
+from geobrep.errors import FormatError, import_optional
 from geobrep.model.entities import Entity, LinearOctree
 from geobrep.model.scene import Scene
 
@@ -49,11 +49,7 @@ _SCENE_ARRAY: Final = "geobrep_scene"
 
 def import_pyvista(feature: str) -> Any:
     """The ``pyvista`` module, or :class:`MissingDependencyError` naming the ``viz`` extra."""
-    try:
-        import pyvista
-    except ImportError as exc:
-        raise MissingDependencyError("pyvista", "viz", feature) from exc
-    return pyvista
+    return import_optional("pyvista", "viz", feature)
 
 
 def _padded(conn: NDArray[np.int64]) -> NDArray[np.int64]:

@@ -18,7 +18,6 @@ per-file work on a Dask cluster (a ``dask.distributed.Client`` or a scheduler ad
 from __future__ import annotations
 
 import glob
-import importlib
 import re
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -29,7 +28,7 @@ from typing import Any, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict
 
-from geobrep.errors import FileAccessError, FormatError, GeobrepError, OptionsError
+from geobrep.errors import FileAccessError, FormatError, GeobrepError, OptionsError, import_optional
 from geobrep.host.capabilities import (
     format_losses,
     has_geometry,
@@ -414,12 +413,7 @@ def _run_dask(
     arguments: Sequence[tuple[Any, ...]],
     done: Callable[[int, R | None, BaseException | None], None],
 ) -> None:
-    try:
-        distributed = importlib.import_module("distributed")
-    except ImportError as exc:
-        from geobrep.errors import MissingDependencyError
-
-        raise MissingDependencyError("distributed", "dask", "running on a Dask cluster") from exc
+    distributed = import_optional("distributed", "dask", "running on a Dask cluster")
     own = isinstance(client, str)
     active = distributed.Client(client) if own else client
     try:

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.errors import MissingDependencyError
+from geobrep.errors import import_optional
 from geobrep.model.crs import CRS, CRSError, as_crs
 from geobrep.model.entities import (
     Annotation,
@@ -88,11 +88,7 @@ _SHORT_UNITS = {
 
 
 def _pyproj() -> Any:
-    try:
-        import pyproj
-    except ImportError as exc:  # pragma: no cover - exercised only without the extra
-        raise MissingDependencyError("pyproj", "gis", "CRS parsing and reprojection") from exc
-    return pyproj
+    return import_optional("pyproj", "gis", "CRS parsing and reprojection")
 
 
 def _from_text(text: Any, what: str) -> pyproj.CRS:
@@ -432,11 +428,7 @@ def to_crs(
 
 # -- geopandas bridge ---------------------------------------------------------------------------
 def _geopandas() -> Any:
-    try:
-        geopandas = importlib.import_module("geopandas")  # untyped: kept Any
-    except ImportError as exc:  # pragma: no cover - exercised only without the extra
-        raise MissingDependencyError("geopandas", "gis", "the geopandas bridge") from exc
-    return geopandas
+    return import_optional("geopandas", "gis", "the geopandas bridge")
 
 
 def crs_text(crs: CRS | None) -> str | None:

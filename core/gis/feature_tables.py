@@ -29,7 +29,6 @@ degenerate, missing z) are skipped with a :class:`FeatureWarning` naming layer a
 
 from __future__ import annotations
 
-import importlib
 import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -39,7 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict
 
-from geobrep.errors import MissingDependencyError
+from geobrep.errors import import_optional
 from geobrep.model.entities import Annotation, Entity, PointSet, Polygon, PolyLine
 
 __all__ = [
@@ -111,11 +110,7 @@ class FeatureTable:
 
 
 def _shapely() -> Any:
-    try:
-        shapely = importlib.import_module("shapely")  # untyped: kept Any
-    except ImportError as exc:  # pragma: no cover - exercised only without the extra
-        raise MissingDependencyError("shapely", "gis", "GIS features") from exc
-    return shapely
+    return import_optional("shapely", "gis", "GIS features")
 
 
 # -- writing ------------------------------------------------------------------------------------

@@ -23,7 +23,6 @@ UTM-scale coordinates keep full precision. shapely (the ``gis`` extra) does the 
 
 from __future__ import annotations
 
-import importlib
 import math
 import re
 from collections.abc import Iterable, Sequence
@@ -35,8 +34,8 @@ from numpy.typing import ArrayLike, NDArray
 from geobrep.errors import (
     DegenerateGeometryError,
     EntityNotFoundError,
-    MissingDependencyError,
     OptionsError,
+    import_optional,
 )
 from geobrep.geometry import Plane, mesh
 from geobrep.model.base import FrozenModel
@@ -70,11 +69,7 @@ RELATIVE_TOLERANCE = 1e-9
 
 
 def _shapely() -> Any:
-    try:
-        shapely = importlib.import_module("shapely")  # untyped: kept Any
-    except ImportError as exc:  # pragma: no cover - exercised only without the extra
-        raise MissingDependencyError("shapely", "gis", "map products") from exc
-    return shapely
+    return import_optional("shapely", "gis", "map products")
 
 
 def _centre(scene: Scene) -> tuple[NDArray[np.float64], float]:
