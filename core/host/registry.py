@@ -16,10 +16,10 @@ from __future__ import annotations
 
 import re
 import warnings
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, ClassVar, Generic, Protocol, TypeVar, runtime_checkable
 
 from pydantic import (
     AliasChoices,
@@ -32,25 +32,39 @@ from pydantic import (
 
 from geobrep.errors import GeobrepError, OptionsError, PluginError, UnknownFormatError
 
+if TYPE_CHECKING:
+    from geobrep.geometry import Plane
+    from geobrep.model.entities import Entity, LinearOctree
+    from geobrep.model.scene import Scene
+
 __all__ = [
     "SNIFF_BYTES",
+    "BuildFunction",
     "BuilderRegistry",
     "BuilderSpec",
+    "ClipFunction",
     "ClipperRegistry",
     "ClipperSpec",
+    "FitFunction",
     "FitterRegistry",
     "FitterSpec",
     "FormatCapabilities",
     "FormatRegistry",
     "FormatSpec",
     "GeobrepPluginWarning",
+    "LossReporter",
     "NoOptions",
+    "Reader",
     "RegisteredItem",
     "Registries",
     "Registry",
+    "SectionFunction",
+    "Sniffer",
     "UnknownItemError",
+    "VoxelizeFunction",
     "VoxelizerRegistry",
     "VoxelizerSpec",
+    "Writer",
 ]
 
 SNIFF_BYTES = 4096
@@ -58,6 +72,73 @@ SNIFF_BYTES = 4096
 
 _NAME_PATTERN = re.compile(r"[a-z0-9][a-z0-9_.-]*")
 _EXTENSION_PATTERN = re.compile(r"(\.[a-z0-9_+~-]+)+")
+
+
+# -- what the callables of registered items look like (positional: any parameter names) -------
+@runtime_checkable
+class Reader(Protocol):
+    """``reader(path, options) -> Scene`` (or one entity, wrapped in a Scene by the caller)."""
+
+    def __call__(self, path: Path, options: Any, /) -> Scene | Entity: ...
+
+
+@runtime_checkable
+class Writer(Protocol):
+    """``writer(scene, path, options)``: writes ``path`` (through ``atomic_write``)."""
+
+    def __call__(self, scene: Scene, path: Path, options: Any, /) -> None: ...
+
+
+@runtime_checkable
+class Sniffer(Protocol):
+    """``sniff(head) -> bool``: whether the first :data:`SNIFF_BYTES` bytes are this format."""
+
+    def __call__(self, head: bytes, /) -> bool: ...
+
+
+@runtime_checkable
+class LossReporter(Protocol):
+    """``losses(scene, path) -> [sentence, ...]``: what a writer drops for this target."""
+
+    def __call__(self, scene: Scene, path: Path, /) -> list[str]: ...
+
+
+@runtime_checkable
+class ClipFunction(Protocol):
+    """``function(entity, plane, keep, options, context)``: the clipped entity, ``None``, or
+    ``(negative, positive)`` for ``keep="both"``."""
+
+    def __call__(
+        self, entity: Any, plane: Plane, keep: Any, options: Any, context: Any, /
+    ) -> Any: ...
+
+
+@runtime_checkable
+class SectionFunction(Protocol):
+    """``section(entity, plane, options, context)``: the cut itself, or ``None``."""
+
+    def __call__(self, entity: Any, plane: Plane, options: Any, context: Any, /) -> Any: ...
+
+
+@runtime_checkable
+class FitFunction(Protocol):
+    """``function(entities, options)``: a ``FitResult`` (or a bare surface)."""
+
+    def __call__(self, entities: list[Any], options: Any, /) -> Any: ...
+
+
+@runtime_checkable
+class BuildFunction(Protocol):
+    """``function(scene, options) -> Scene`` (a new scene; scenes are never changed)."""
+
+    def __call__(self, scene: Scene, options: Any, /) -> Scene: ...
+
+
+@runtime_checkable
+class VoxelizeFunction(Protocol):
+    """``function(scene, options) -> LinearOctree`` of the scene's closed bodies."""
+
+    def __call__(self, scene: Scene, options: Any, /) -> LinearOctree: ...
 
 
 class GeobrepPluginWarning(UserWarning):
@@ -241,11 +322,11 @@ class FormatSpec(RegisteredItem):
     kind: ClassVar[str] = "format"
 
     extensions: tuple[str, ...] = ()
-    reader: Callable[..., Any] | None = None
-    writer: Callable[..., Any] | None = None
-    sniff: Callable[[bytes], bool] | None = None
+    reader: Reader | None = None
+    writer: Writer | None = None
+    sniff: Sniffer | None = None
     capabilities: FormatCapabilities = FormatCapabilities()
-    losses: Callable[..., list[str]] | None = None
+    losses: LossReporter | None = None
     """``losses(scene, path) -> [sentence, ...]``: what the writer drops for this target beyond
     what :attr:`capabilities` says (e.g. a GOCAD .ts holds surfaces only)."""
     generic_content: bool = False
@@ -314,8 +395,8 @@ class ClipperSpec(RegisteredItem):
     kind: ClassVar[str] = "clipper"
 
     entity_type: str
-    function: Callable[..., Any]
-    section: Callable[..., Any] | None = None
+    function: ClipFunction
+    section: SectionFunction | None = None
 
 
 class FitterSpec(RegisteredItem):
@@ -328,7 +409,7 @@ class FitterSpec(RegisteredItem):
 
     kind: ClassVar[str] = "fitter"
 
-    function: Callable[..., Any]
+    function: FitFunction
     input_types: tuple[str, ...] = ()
 
 
@@ -342,7 +423,7 @@ class BuilderSpec(RegisteredItem):
 
     kind: ClassVar[str] = "builder"
 
-    function: Callable[..., Any]
+    function: BuildFunction
     input_types: tuple[str, ...] = ()
 
 
@@ -360,7 +441,7 @@ class VoxelizerSpec(RegisteredItem):
 
     kind: ClassVar[str] = "voxelizer"
 
-    function: Callable[..., Any]
+    function: VoxelizeFunction
 
 
 T = TypeVar("T", bound=RegisteredItem)
