@@ -18,8 +18,9 @@ Everything a plugin needs is importable from here: the :data:`hookimpl` marker, 
 registry types (``FormatSpec``, ``ClipperSpec``, ``FitterSpec``, ``BuilderSpec``,
 ``VoxelizerSpec``, ...) and the Protocols their callables follow (``Reader``, ``Writer``,
 ``ClipFunction``, ``FitFunction``, ...), the clipping context (``ClipContext``, ``SceneDraft``,
-``halves``, ``pack_halves``), the fit result types (``FitResult``, ``FitReport``), ``atomic_write``, the
-topology helpers (``chain_arc_edges``, ``build_corners_and_arcs``) and the errors. The model
+``halves``, ``pack_halves``), the fit result types (``FitResult``, ``FitReport``),
+``atomic_write``, the topology helpers (``chain_arc_edges``, ``build_corners_and_arcs``) and the
+errors. The model
 itself (``Scene``, ``Surface``, ``Plane``, ...) comes from :mod:`geobrep`, the kernels from
 :mod:`geobrep.geometry`. The built-in plugins below use only these three.
 
