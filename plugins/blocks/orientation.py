@@ -54,21 +54,15 @@ class DirectionTriangles:
         starts = self.offsets[groups]
         counts = self.offsets[groups + 1] - starts
         rows = concatenated_ranges(starts, counts)
-        return DirectionTriangles(
-            offsets=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
-            arc=self.arc[rows],
-            edge_position=self.edge_position[rows],
-            start=self.start[rows],
-            end=self.end[rows],
-            triangle=self.triangle[rows],
-            patch=self.patch[rows],
-            forward=self.forward[rows],
-        )
+        return self._rows(rows, np.concatenate([[0], np.cumsum(counts)]).astype(np.int64))
 
     def reorder(self, rows: IntArray) -> DirectionTriangles:
         """The same groups with rows permuted (``rows`` must keep each group's rows together)."""
+        return self._rows(rows, self.offsets)
+
+    def _rows(self, rows: IntArray, offsets: IntArray) -> DirectionTriangles:
         return DirectionTriangles(
-            offsets=self.offsets,
+            offsets=offsets,
             arc=self.arc[rows],
             edge_position=self.edge_position[rows],
             start=self.start[rows],

@@ -13,6 +13,7 @@ plugin stays cheap.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from geobrep.plugins import FitterRegistry, FitterSpec, hookimpl
@@ -53,39 +54,25 @@ def _hybrid(entities: list[Any], options: HybridOptions) -> Any:
 @hookimpl
 def geobrep_register_fitters(registry: FitterRegistry) -> None:
     """Register ``skinning``, ``approximation``, ``kriging`` and ``hybrid``."""
-    registry.add(
-        FitterSpec(
-            name="skinning",
-            description="NURBS skinning: interpolate ordered sections, exact at every point",
-            function=_skinning,
-            input_types=("PointSet", "PolyLine"),
-            options=SkinningOptions,
+    both = ("PointSet", "PolyLine")
+    # name, function, input types, options model, description
+    table: list[tuple[str, Callable[..., Any], tuple[str, ...], type, str]] = [
+        ("skinning", _skinning, both, SkinningOptions,
+         "NURBS skinning: interpolate ordered sections, exact at every point"),
+        ("approximation", _approximation, both, ApproximationOptions,
+         "NURBS least squares with smoothing, ε-driven net size, boundary curves"),
+        ("kriging", _kriging, both, KrigingOptions,
+         "Ordinary/universal kriging onto a grid (prediction + variance)"),
+        ("hybrid", _hybrid, ("PointSet",), HybridOptions,
+         "Skin the dense core, approximate the sparse rim against it (Li 2011)"),
+    ]  # fmt: skip
+    for name, function, input_types, options, description in table:
+        registry.add(
+            FitterSpec(
+                name=name,
+                description=description,
+                function=function,
+                input_types=input_types,
+                options=options,
+            )
         )
-    )
-    registry.add(
-        FitterSpec(
-            name="approximation",
-            description="NURBS least squares with smoothing, ε-driven net size, boundary curves",
-            function=_approximation,
-            input_types=("PointSet", "PolyLine"),
-            options=ApproximationOptions,
-        )
-    )
-    registry.add(
-        FitterSpec(
-            name="kriging",
-            description="Ordinary/universal kriging onto a grid (prediction + variance)",
-            function=_kriging,
-            input_types=("PointSet", "PolyLine"),
-            options=KrigingOptions,
-        )
-    )
-    registry.add(
-        FitterSpec(
-            name="hybrid",
-            description="Skin the dense core, approximate the sparse rim against it (Li 2011)",
-            function=_hybrid,
-            input_types=("PointSet",),
-            options=HybridOptions,
-        )
-    )

@@ -19,8 +19,9 @@ True
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 import scipy.linalg as la
@@ -51,6 +52,7 @@ from geobrep.plugins.fit.report import accuracy_report, sigma
 __all__ = [
     "NetFit",
     "approximate_points",
+    "coarse_to_fine",
     "collect_points",
     "fit_approximation",
     "smoothing_weight",
@@ -59,6 +61,8 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
+Level = TypeVar("Level")
+Fitted = TypeVar("Fitted")
 
 _ALONG_V: tuple[Side, ...] = ("u0", "u1")  # curves on these sides run along v
 
@@ -95,6 +99,27 @@ def collect_points(entities: list[Entity], label: str) -> tuple[FloatArray, Poin
     if not parts:
         raise OptionsError(f"{label}: no points given")
     return np.concatenate(parts), first
+
+
+def coarse_to_fine(
+    levels: Iterable[Level],
+    fit: Callable[[int, Level], Fitted],
+    good_enough: Callable[[Fitted], bool],
+) -> Fitted:
+    """Fit level after level (``fit(number, level)``, numbered from 1) until one is good enough;
+    the finest one when none is."""
+    fitted: Fitted | None = None
+    for number, level in enumerate(levels, 1):
+        fitted = fit(number, level)
+        if good_enough(fitted):
+            break
+    assert fitted is not None
+    return fitted
+
+
+def _sigma_below(epsilon: float | None) -> Callable[[NetFit], bool]:
+    """Whether a fit's σ meets ``epsilon`` (never, without one: the first net is final)."""
+    return lambda fitted: epsilon is not None and fitted.sigma < epsilon
 
 
 def smoothing_weight(smoothing: float, n_points: int, width: float, height: float) -> float:
@@ -319,10 +344,9 @@ def _plane_fit(
     lam = smoothing_weight(options.smoothing, local.shape[0], width, height)
     along_u = [c.curve.knots for c in constraints if c.side not in _ALONG_V]
     along_v = [c.curve.knots for c in constraints if c.side in _ALONG_V]
-    best: NetFit | None = None
-    for tried, (spans_u, spans_v) in enumerate(
-        net_levels(width, height, local.shape[0], options), 1
-    ):
+
+    def fit_level(tried: int, spans: tuple[int, int]) -> NetFit:
+        spans_u, spans_v = spans
         ku = _inner_knots(p, spans_u, along_u)
         kv = _inner_knots(q, spans_v, along_v)
         nu, nv = ku.shape[0] - p - 1, kv.shape[0] - q - 1
@@ -362,7 +386,7 @@ def _plane_fit(
         else:  # the planar map is exactly affine: only the heights differ
             on_heights = surface_points(net.with_control_points(heights), u, v)
             residuals = np.abs(on_heights[:, 0] - local[:, 2])
-        best = NetFit(
+        return NetFit(
             net,
             u,
             v,
@@ -370,10 +394,9 @@ def _plane_fit(
             notes,
             {"control_points": [nu, nv], "smoothing_lambda": lam, "nets_tried": tried},
         )
-        if options.epsilon is not None and best.sigma < options.epsilon:
-            break
-    assert best is not None
-    return best
+
+    levels = net_levels(width, height, local.shape[0], options)
+    return coarse_to_fine(levels, fit_level, _sigma_below(options.epsilon))
 
 
 def _surface_lengths(net: NurbsNet) -> tuple[float, float]:
@@ -403,10 +426,9 @@ def _base_surface_fit(
     along_u = [c.curve.knots for c in constraints if c.side not in _ALONG_V]
     along_v = [c.curve.knots for c in constraints if c.side in _ALONG_V]
     lam = smoothing_weight(options.smoothing, local.shape[0], width, height)
-    best: NetFit | None = None
-    for tried, (spans_u, spans_v) in enumerate(
-        net_levels(width, height, local.shape[0], options), 1
-    ):
+
+    def fit_level(tried: int, spans: tuple[int, int]) -> NetFit:
+        spans_u, spans_v = spans
         ku = _inner_knots(p, spans_u, along_u)
         kv = _inner_knots(q, spans_v, along_v)
         nu, nv = ku.shape[0] - p - 1, kv.shape[0] - q - 1
@@ -424,7 +446,7 @@ def _base_surface_fit(
         )
         net = NurbsNet(p, q, ku, kv, control)
         residuals = np.linalg.norm(surface_points(net, u, v) - local, axis=1)
-        best = NetFit(
+        return NetFit(
             net,
             u,
             v,
@@ -432,10 +454,9 @@ def _base_surface_fit(
             [],
             {"control_points": [nu, nv], "smoothing_lambda": lam, "nets_tried": tried},
         )
-        if options.epsilon is not None and best.sigma < options.epsilon:
-            break
-    assert best is not None
-    return best
+
+    levels = net_levels(width, height, local.shape[0], options)
+    return coarse_to_fine(levels, fit_level, _sigma_below(options.epsilon))
 
 
 def _grid_parameters(grid: FloatArray, axis: int) -> FloatArray:
@@ -476,10 +497,9 @@ def _grid_fit(local: FloatArray, options: ApproximationOptions) -> NetFit:
     lam = smoothing_weight(options.smoothing, local.shape[0], width, height)
     u = np.repeat(u_rows, columns)
     v = np.tile(v_columns, rows)
-    best: NetFit | None = None
-    for tried, (spans_u, spans_v) in enumerate(
-        net_levels(width, height, local.shape[0], options), 1
-    ):
+
+    def fit_level(tried: int, spans: tuple[int, int]) -> NetFit:
+        spans_u, spans_v = spans
         nu, nv = min(spans_u + p, rows), min(spans_v + q, columns)
         ku = approximation_knots(p, nu, u_rows)
         kv = approximation_knots(q, nv, v_columns)
@@ -506,7 +526,7 @@ def _grid_fit(local: FloatArray, options: ApproximationOptions) -> NetFit:
         on_rows = (a_u @ net.reshape(nu, -1)).reshape(rows, nv, 3)
         fitted = np.matmul(a_v[None, :, :], on_rows).reshape(-1, 3)
         residuals = np.linalg.norm(fitted - local, axis=1)
-        best = NetFit(
+        return NetFit(
             NurbsNet(p, q, ku, kv, np.ascontiguousarray(net)),
             u,
             v,
@@ -519,10 +539,9 @@ def _grid_fit(local: FloatArray, options: ApproximationOptions) -> NetFit:
                 "grid_shape": [rows, columns],
             },
         )
-        if options.epsilon is not None and best.sigma < options.epsilon:
-            break
-    assert best is not None
-    return best
+
+    levels = net_levels(width, height, local.shape[0], options)
+    return coarse_to_fine(levels, fit_level, _sigma_below(options.epsilon))
 
 
 def approximate_points(

@@ -30,6 +30,7 @@ from geobrep.geometry.nurbs import NurbsNet, greville_abscissae, surface_points
 from geobrep.plugins import FitResult
 from geobrep.plugins.fit.approximation import (
     NetFit,
+    coarse_to_fine,
     collect_points,
     nurbs_from_local,
     smoothing_weight,
@@ -405,15 +406,18 @@ def _fit_rim(core: _Core, options: HybridOptions, n_rim: int) -> tuple[NetFit, L
     rim_area = max(width * height - core_area, 0.25 * width * height)
     lam = smoothing_weight(options.smoothing, n_rim, width, height)
     rim_rows = slice(core.data.skinned.shape[0] + core.data.exact.shape[0], None)
-    best: tuple[NetFit, Layout] | None = None
-    for number, spans in enumerate(_rim_levels(widths, rim_area, n_rim, options), 1):
+    epsilon = options.epsilon
+
+    def fit_level(number: int, spans: NDArray[np.int64]) -> tuple[NetFit, Layout]:
         fitted, layout = _fit_level(core.skinned, spans, core.data, rect, breaks, lam)
         fitted.details["nets_tried"] = number
-        best = (fitted, layout)
-        if options.epsilon is not None and sigma(fitted.residuals[rim_rows]) < options.epsilon:
-            break
-    assert best is not None
-    return best
+        return fitted, layout
+
+    def rim_meets_epsilon(best: tuple[NetFit, Layout]) -> bool:
+        return epsilon is not None and sigma(best[0].residuals[rim_rows]) < epsilon
+
+    levels = _rim_levels(widths, rim_area, n_rim, options)
+    return coarse_to_fine(levels, fit_level, rim_meets_epsilon)
 
 
 def _hybrid_result(

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -105,19 +106,16 @@ def _global(
         raise DegenerateGeometryError(
             f"{LABEL}: the drift cannot be estimated (points on a line?)"
         ) from exc
-    prediction = np.empty(targets.shape[0])
-    variance = np.empty(targets.shape[0])
-    for start in range(0, targets.shape[0], _GLOBAL_BLOCK):
-        block = targets[start : start + _GLOBAL_BLOCK]
+
+    def predict(block: FloatArray) -> tuple[FloatArray, FloatArray]:
         c0 = model.covariance(cdist(xy, block), exact_at=exact_at)  # (n, B)
         r = la.solve_triangular(lower, c0, lower=True, check_finite=False)
         g = w.T @ r - _drift(block, linear, scale).T  # (m, B)
         qg = la.cho_solve(q_factor, g)
-        prediction[start : start + _GLOBAL_BLOCK] = r.T @ zt - qg.T @ wz
-        variance[start : start + _GLOBAL_BLOCK] = (
-            model.sill - np.einsum("ij,ij->j", r, r) + np.einsum("ij,ij->j", g, qg)
-        )
-    return prediction, variance
+        variance = model.sill - np.einsum("ij,ij->j", r, r) + np.einsum("ij,ij->j", g, qg)
+        return r.T @ zt - qg.T @ wz, variance
+
+    return _blockwise(targets, predict)
 
 
 def _global_bordered(
@@ -145,16 +143,26 @@ def _global_bordered(
             f"{LABEL}: the kriging system is singular (duplicate points without a nugget, or a "
             "gaussian model without a nugget); add a nugget or remove duplicates"
         )
-    prediction = np.empty(targets.shape[0])
-    variance = np.empty(targets.shape[0])
-    for start in range(0, targets.shape[0], _GLOBAL_BLOCK):
-        block = targets[start : start + _GLOBAL_BLOCK]
+
+    def predict(block: FloatArray) -> tuple[FloatArray, FloatArray]:
         rhs = np.vstack(
             [model.covariance(cdist(xy, block), exact_at=exact_at), _drift(block, linear, scale).T]
         )
         solution = la.lu_solve(lu, rhs, check_finite=False)
-        prediction[start : start + _GLOBAL_BLOCK] = solution[:n].T @ z
-        variance[start : start + _GLOBAL_BLOCK] = model.sill - np.einsum("ij,ij->j", solution, rhs)
+        return solution[:n].T @ z, model.sill - np.einsum("ij,ij->j", solution, rhs)
+
+    return _blockwise(targets, predict)
+
+
+def _blockwise(
+    targets: FloatArray, predict: Callable[[FloatArray], tuple[FloatArray, FloatArray]]
+) -> tuple[FloatArray, FloatArray]:
+    """Prediction and variance at ``targets``, ``_GLOBAL_BLOCK`` targets at a time."""
+    prediction = np.empty(targets.shape[0])
+    variance = np.empty(targets.shape[0])
+    for start in range(0, targets.shape[0], _GLOBAL_BLOCK):
+        rows = slice(start, start + _GLOBAL_BLOCK)
+        prediction[rows], variance[rows] = predict(targets[rows])
     return prediction, variance
 
 
