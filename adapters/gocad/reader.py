@@ -338,7 +338,9 @@ class _Builder:
         cell_data = _properties(obj.cell_header, values, obj.class_headers, where, self.error)
         names = tuple(name or str(i) for i, name in enumerate(obj.part_names))
         if obj.type == "TSurf":
+            self._warn_empty_tfaces(obj, parts)
             self._hints(obj, lookup, fields)
+            self._warn_inner_borders(obj, index, parts, fields)
             self.entities.append(
                 Surface(
                     vertices=xyz,
@@ -358,6 +360,46 @@ class _Builder:
             self._tsolid(
                 obj, xyz, index, parts, names, point_data, cell_data, fields, lookup, vertices
             )
+
+    def _warn_empty_tfaces(self, obj: GocadObject, parts: NDArray[np.int64]) -> None:
+        """One warning per TFACE without triangles: a writer writes no TFACE for an empty patch
+        (except the one TFACE of a surface without any triangle), so it does not come back."""
+        n_parts = len(obj.part_names)
+        if n_parts <= 1 and parts.size == 0:
+            return
+        counts = np.bincount(parts, minlength=n_parts)
+        for label in np.flatnonzero(counts == 0).tolist():
+            self.warn(
+                f"TSurf {obj.name!r}: TFACE {label + 1} has no triangles (an empty patch, "
+                "which is not written back)",
+                obj.part_lines[label],
+            )
+
+    def _warn_inner_borders(
+        self,
+        obj: GocadObject,
+        faces: NDArray[np.int64],
+        parts: NDArray[np.int64],
+        fields: _EntityFields,
+    ) -> None:
+        """One warning per surface whose BORDERs do not all run along a border edge of its
+        TFACEs (an edge of one triangle of a patch): a writer then derives its BSTONE and
+        BORDER lines from the corners and arcs, so they need not come back as they were."""
+        borders = fields["metadata"]["gocad"].get("borders")
+        if not borders:
+            return
+        pairs = np.asarray(borders, dtype=np.int64)
+        n = int(max(faces.max(initial=0), pairs.max())) + 1
+        on_border = np.isin(_edge_keys(pairs, n), _border_edges(faces, parts, n))
+        if on_border.all():
+            return
+        first = int(np.argmin(on_border))
+        self.warn(
+            f"TSurf {obj.name!r}: {int((~on_border).sum())} BORDER(s) not along a border edge "
+            "of its TFACEs (this one first); BSTONE/BORDER lines are derived from the corners "
+            "and arcs when written",
+            obj.borders[first].line,
+        )
 
     def _hints(self, obj: GocadObject, lookup: IdLookup, fields: _EntityFields) -> None:
         """BSTONE / BORDER lines as vertex indices in ``metadata["gocad"]``."""
@@ -637,6 +679,24 @@ class _Builder:
                 },
             )
         )
+
+
+def _edge_keys(pairs: NDArray[np.int64], n: int) -> NDArray[np.int64]:
+    """``min * n + max`` of each vertex pair (rows of ``pairs``)."""
+    keys: NDArray[np.int64] = pairs.min(axis=1) * n + pairs.max(axis=1)
+    return keys
+
+
+def _border_edges(faces: NDArray[np.int64], parts: NDArray[np.int64], n: int) -> NDArray[np.int64]:
+    """Keys (:func:`_edge_keys`) of the edges one triangle of a patch uses: the patches'
+    borders."""
+    if faces.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    edges = faces[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2)
+    rows = np.column_stack([np.repeat(parts, 3), _edge_keys(edges, n)])
+    unique, counts = np.unique(rows, axis=0, return_counts=True)
+    keys: NDArray[np.int64] = np.unique(unique[counts == 1, 1])
+    return keys
 
 
 def _majority_names(obj: GocadObject, component: NDArray[np.int64], count: int) -> list[str]:

@@ -165,8 +165,9 @@ class _Writer:
             lo, hi = int(bounds[part]), int(bounds[part + 1])
             values = cell_values[lo:hi] if cell_values is not None else None
             out.add_pieces(row_pieces(b"TRGL", faces[lo:hi] + 1, values))
-        if n_parts == 0:
-            out.add("TFACE")
+        if n_parts == 0:  # no triangles: one TFACE holds the vertices (the patch's name kept)
+            name = surface.patch_name(0) if surface.n_patches else "0"
+            out.add("TFACE" if name == "0" else f"TFACE {name}")
             out.add_pieces(vw.lines(0, surface.n_vertices))
         self.borders(out, surface)
         self.tail(out, surface)
