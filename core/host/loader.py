@@ -3,13 +3,20 @@
 Plugins come from the ``geobrep.plugins`` entry-point group (built-ins too), loaded in a
 deterministic order: built-ins (module ``geobrep.*``) first, then the rest by entry-point
 name. Each plugin is imported, registered with pluggy and has its hooks called on its own,
-into staging registries; only a plugin that succeeds entirely is committed. A failure is a
+into staging registries; only a plugin that succeeds entirely is committed. A failure (any
+exception, :class:`BaseException` subclasses included, but :class:`KeyboardInterrupt`) is a
 :class:`~geobrep.host.registry.GeobrepPluginWarning` and the plugin is marked ``"failed"``.
+
+The import and the hooks of a plugin from another distribution run in a daemon thread
+(:func:`geobrep.host.isolation.call_bounded`): one that does not finish within
+``GEOBREP_PLUGIN_TIMEOUT`` seconds (default 10) is reported, skipped and abandoned. geobrep's
+own plugins are imported directly and their items are marked ``builtin``.
 
 Environment:
     ``GEOBREP_STRICT_PLUGINS=1`` (also ``true``/``yes``/``on``): a failure raises
     :class:`~geobrep.errors.PluginError` instead of warning.
     ``GEOBREP_DISABLE_PLUGINS=a,b``: entry-point names never imported (status ``"disabled"``).
+    ``GEOBREP_PLUGIN_TIMEOUT=seconds``: the time limit above.
 
 Example:
     >>> host = get_host()
@@ -32,6 +39,15 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from geobrep.errors import PluginError
 from geobrep.hookspecs import PROJECT_NAME, GeobrepSpecs
+from geobrep.host.isolation import (
+    STRICT_ENV,
+    TIMEOUT_ENV,
+    PluginTimeoutError,
+    call_bounded,
+    in_plugin_thread,
+    plugin_timeout,
+    strict_mode,
+)
 from geobrep.host.registry import GeobrepPluginWarning, RegisteredItem, Registries, Registry
 
 __all__ = [
@@ -39,6 +55,7 @@ __all__ = [
     "ENTRY_POINT_GROUP",
     "HOOK_KINDS",
     "STRICT_ENV",
+    "TIMEOUT_ENV",
     "PluginHost",
     "PluginInfo",
     "disabled_plugins",
@@ -51,7 +68,6 @@ __all__ = [
 ]
 
 ENTRY_POINT_GROUP = "geobrep.plugins"
-STRICT_ENV = "GEOBREP_STRICT_PLUGINS"
 DISABLE_ENV = "GEOBREP_DISABLE_PLUGINS"
 
 HOOK_KINDS: dict[str, str] = {
@@ -90,13 +106,10 @@ class PluginInfo(BaseModel):
     distribution: str | None = None
     version: str | None = None
     status: Status
+    builtin: bool = False
+    """A plugin of geobrep itself (its formats win extension ties over other plugins')."""
     error: str | None = None
     registered: dict[str, tuple[str, ...]] = Field(default_factory=_nothing_registered)
-
-
-def strict_mode() -> bool:
-    """True if ``GEOBREP_STRICT_PLUGINS`` asks for plugin failures to raise."""
-    return os.environ.get(STRICT_ENV, "").strip().lower() in {"1", "true", "yes", "on"}
 
 
 def disabled_plugins() -> frozenset[str]:
@@ -114,6 +127,11 @@ def _distribution(entry_point: EntryPoint) -> tuple[str | None, str | None]:
     if dist is None:
         return None, None
     return dist.name, dist.version
+
+
+def _is_own(entry_point: EntryPoint) -> bool:
+    """A built-in module declared by geobrep's own distribution (or by code, without one)."""
+    return _is_builtin(entry_point) and _distribution(entry_point)[0] in (None, PROJECT_NAME)
 
 
 def discover_entry_points() -> list[EntryPoint]:
@@ -200,6 +218,7 @@ class PluginHost:
     def _load_entry_point(self, entry_point: EntryPoint, disabled: frozenset[str]) -> None:
         name, module = entry_point.name, entry_point.module
         distribution, version = _distribution(entry_point)
+        builtin = _is_own(entry_point)
         if name in disabled:
             self._plugins.append(
                 PluginInfo(
@@ -208,17 +227,24 @@ class PluginHost:
                     distribution=distribution,
                     version=version,
                     status="disabled",
+                    builtin=builtin,
                 )
             )
             return
         if self._taken(name, module, distribution, version):
             return
+        limit = None if builtin else plugin_timeout()
         try:
-            plugin = entry_point.load()
-        except (Exception, SystemExit) as exc:
+            if limit is None:
+                plugin = entry_point.load()
+            else:
+                plugin = call_bounded(entry_point.load, limit, f"the import of {module!r}")
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # plugin code: isolated and reported
             self._fail(name, module, distribution, version, exc)
             return
-        self._register(plugin, name, module, distribution, version)
+        self._register(plugin, name, module, distribution, version, builtin=builtin, limit=limit)
 
     def _taken(self, name: str, module: str, distribution: str | None, version: str | None) -> bool:
         for info in self._plugins:
@@ -236,18 +262,29 @@ class PluginHost:
         module: str,
         distribution: str | None,
         version: str | None,
+        *,
+        builtin: bool = False,
+        limit: float | None = None,
     ) -> PluginInfo:
+        """Register ``plugin`` and call its hooks (within ``limit`` seconds, if given)."""
         if self._taken(name, module, distribution, version):
             return self._plugins[-1]
-        staging = Registries.staging(name)
+        staging = Registries.staging(name, builtin=builtin)
         registered_with_pluggy = False
         try:
             if self.manager.register(plugin, name=name) is None:
                 raise PluginError(f"pluggy blocked the plugin name {name!r}")
             registered_with_pluggy = True
             self.manager.check_pending()
-            self._call_hooks(name, staging)
-        except (Exception, SystemExit) as exc:
+            if limit is None:
+                self._call_hooks(name, staging)
+            else:
+                call_bounded(
+                    lambda: self._call_hooks(name, staging), limit, f"the hooks of {name!r}"
+                )
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # plugin code: isolated and reported
             if registered_with_pluggy:
                 self.manager.unregister(name=name)
             return self._fail(name, module, distribution, version, exc)
@@ -257,6 +294,7 @@ class PluginHost:
             distribution=distribution,
             version=version,
             status="loaded",
+            builtin=builtin,
             registered=self._commit(staging),
         )
         self._plugins.append(info)
@@ -306,6 +344,8 @@ class PluginHost:
         )
         self._plugins.append(info)
         message = f"{_origin(name, module, distribution, version)} failed: {error}"
+        if isinstance(exc, PluginTimeoutError):
+            message += f" (the limit is {TIMEOUT_ENV}, in seconds)"
         if strict_mode():
             raise PluginError(message) from exc
         warnings.warn(
@@ -332,6 +372,9 @@ def get_host() -> PluginHost:
     host = _host
     if host is not None:
         return host
+    if _loading and in_plugin_thread():
+        # the loader holds the lock while it waits for this thread: refuse, do not deadlock
+        raise PluginError("geobrep plugins were used by a plugin hook while loading")
     with _lock:
         if _host is not None:
             return _host

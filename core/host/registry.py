@@ -14,6 +14,7 @@ name twice is a :class:`~geobrep.errors.PluginError`.
 
 from __future__ import annotations
 
+import os
 import re
 import warnings
 from collections.abc import Iterable, Iterator, Mapping
@@ -31,6 +32,13 @@ from pydantic import (
 )
 
 from geobrep.errors import GeobrepError, OptionsError, PluginError, UnknownFormatError
+from geobrep.host.isolation import (
+    SNIFF_TIMEOUT_ENV,
+    PluginTimeoutError,
+    call_bounded,
+    sniff_timeout,
+    strict_mode,
+)
 
 if TYPE_CHECKING:
     from geobrep.geometry import Plane
@@ -38,6 +46,7 @@ if TYPE_CHECKING:
     from geobrep.model.scene import Scene
 
 __all__ = [
+    "PREFER_ENV",
     "SNIFF_BYTES",
     "BuildFunction",
     "BuilderRegistry",
@@ -65,10 +74,15 @@ __all__ = [
     "VoxelizerRegistry",
     "VoxelizerSpec",
     "Writer",
+    "break_tie",
+    "preferred_formats",
 ]
 
 SNIFF_BYTES = 4096
 """How many leading bytes of a file a format's ``sniff`` function receives."""
+
+PREFER_ENV = "GEOBREP_PREFER_FORMATS"
+"""Comma-separated format names that win ties (same extension, or several sniffers agreeing)."""
 
 _NAME_PATTERN = re.compile(r"[a-z0-9][a-z0-9_.-]*")
 _EXTENSION_PATTERN = re.compile(r"(\.[a-z0-9_+~-]+)+")
@@ -183,6 +197,9 @@ class RegisteredItem(BaseModel):
     description: str = ""
     options: type[BaseModel] = NoOptions
     plugin: str = ""
+    builtin: bool = False
+    """Registered by one of geobrep's own plugins (set by the loader; a plugin's value is
+    overwritten). Built-in formats win extension ties over other plugins' formats."""
 
     @field_validator("name")
     @classmethod
@@ -450,8 +467,9 @@ T = TypeVar("T", bound=RegisteredItem)
 class Registry(Generic[T]):
     """Items of one kind by name, iterated in name order.
 
-    ``plugin``, when given, stamps every added item as registered by that plugin (the
-    loader gives each plugin its own staging registry this way).
+    ``plugin``, when given, stamps every added item as registered by that plugin, and as
+    :attr:`~RegisteredItem.builtin` or not by ``builtin`` (the loader gives each plugin its
+    own staging registry this way).
 
     Example:
         >>> registry = ClipperRegistry()
@@ -462,9 +480,12 @@ class Registry(Generic[T]):
 
     item_type: ClassVar[type[RegisteredItem]] = RegisteredItem
 
-    def __init__(self, items: Iterable[T] = (), *, plugin: str | None = None) -> None:
+    def __init__(
+        self, items: Iterable[T] = (), *, plugin: str | None = None, builtin: bool = False
+    ) -> None:
         self._items: dict[str, T] = {}
         self.plugin = plugin
+        self.builtin = builtin
         for item in items:
             self.add(item)
 
@@ -484,8 +505,8 @@ class Registry(Generic[T]):
                 f"{type(self).__name__}.add() takes a {self.item_type.__name__}, "
                 f"not {type(item).__name__} ({item!r:.80})"
             )
-        if self.plugin is not None and item.plugin != self.plugin:
-            item = item.model_copy(update={"plugin": self.plugin})
+        if self.plugin is not None and (item.plugin, item.builtin) != (self.plugin, self.builtin):
+            item = item.model_copy(update={"plugin": self.plugin, "builtin": self.builtin})
         existing = self._items.get(item.name)
         if existing is None:
             self._items[item.name] = item
@@ -584,10 +605,14 @@ class FormatRegistry(Registry[FormatSpec]):
     def choose_reader(self, path: Path | str, format: str | None = None) -> FormatSpec:
         """The format to read ``path`` with.
 
-        An explicit ``format`` name wins; otherwise the longest matching extension, with
-        sniffing of the first :data:`SNIFF_BYTES` bytes to decide between several formats
-        or when no extension matches (formats with ``generic_content`` only when no other
-        sniffer recognises the file).
+        An explicit ``format`` name wins; otherwise the longest matching extension. Of
+        several formats with that extension, one named in ``GEOBREP_PREFER_FORMATS`` wins,
+        else geobrep's built-in formats win over plugins' (:func:`break_tie`). Sniffing of the
+        first :data:`SNIFF_BYTES` bytes decides between those left, or between all readers
+        when no extension matches; of the formats whose sniffer says yes, a preferred one
+        wins, then those without ``generic_content``, then the built-in ones. A plugin
+        sniffer that raises or takes over ``GEOBREP_SNIFF_TIMEOUT`` seconds says no (and is
+        reported: a :class:`GeobrepPluginWarning`, or a :class:`PluginError` in strict mode).
 
         Raises:
             UnknownFormatError: nothing matches, or several formats match equally.
@@ -596,15 +621,16 @@ class FormatRegistry(Registry[FormatSpec]):
         if format is not None:
             return self._named(format, path, "read")
         readers = self.readers()
-        candidates = _longest_match(readers, path)
+        candidates = break_tie(_longest_match(readers, path))
         if len(candidates) == 1:
             return candidates[0]
         head = _read_head(path)
         pool = candidates or readers
         sniffed = [spec for spec in pool if self._sniffs(spec, head)]
         specific = [spec for spec in sniffed if not spec.generic_content]
-        if specific and len(specific) < len(sniffed):
+        if specific and len(specific) < len(sniffed) and _preferred(sniffed) is None:
             sniffed = specific  # a format that knows this content beats a generic one
+        sniffed = break_tie(sniffed)
         if len(sniffed) == 1:
             return sniffed[0]
         if sniffed or candidates:
@@ -619,6 +645,9 @@ class FormatRegistry(Registry[FormatSpec]):
     def choose_writer(self, path: Path | str, format: str | None = None) -> FormatSpec:
         """The format to write ``path`` with: explicit ``format`` name, else extension.
 
+        Of several formats with the extension, :func:`break_tie` picks a preferred or
+        built-in one.
+
         Raises:
             UnknownFormatError: nothing matches, or several formats share the extension.
         """
@@ -626,7 +655,7 @@ class FormatRegistry(Registry[FormatSpec]):
         if format is not None:
             return self._named(format, path, "write")
         writers = self.writers()
-        candidates = _longest_match(writers, path)
+        candidates = break_tie(_longest_match(writers, path))
         if len(candidates) == 1:
             return candidates[0]
         if candidates:
@@ -664,18 +693,75 @@ class FormatRegistry(Registry[FormatSpec]):
 
     @staticmethod
     def _sniffs(spec: FormatSpec, head: bytes) -> bool:
-        if spec.sniff is None or not head:
+        sniff = spec.sniff
+        if sniff is None or not head or id(sniff) in _HUNG_SNIFFERS:
             return False
         try:
-            return bool(spec.sniff(head))
-        except Exception as exc:
-            warnings.warn(
-                f"{spec.label} from {_plugin_label(spec.plugin)}: sniff raised "
-                f"{type(exc).__name__}: {exc}; treated as no match",
-                GeobrepPluginWarning,
-                stacklevel=3,
+            if spec.builtin:
+                return bool(sniff(head))
+            return call_bounded(
+                lambda: bool(sniff(head)), sniff_timeout(), f"the sniffer of {spec.label}"
             )
-            return False
+        except KeyboardInterrupt:
+            raise
+        except PluginTimeoutError as exc:
+            _HUNG_SNIFFERS[id(sniff)] = sniff
+            _report_sniff(
+                spec,
+                f"{exc}; it is treated as no match from now on (the limit is "
+                f"{SNIFF_TIMEOUT_ENV}, in seconds)",
+                exc,
+            )
+        except BaseException as exc:  # plugin code: isolated and reported
+            problem = f"sniff raised {type(exc).__name__}: {exc}; treated as no match"
+            _report_sniff(spec, problem, exc)
+        return False
+
+
+_HUNG_SNIFFERS: dict[int, Sniffer] = {}
+"""Sniffers that overran their time limit (by id; the value keeps the id from being reused)."""
+
+
+def _report_sniff(spec: FormatSpec, problem: str, exc: BaseException) -> None:
+    message = f"{spec.label} from {_plugin_label(spec.plugin)}: {problem}"
+    if strict_mode():
+        raise PluginError(message) from exc
+    warnings.warn(message, GeobrepPluginWarning, stacklevel=4)
+
+
+def preferred_formats() -> tuple[str, ...]:
+    """The format names of ``GEOBREP_PREFER_FORMATS`` (comma separated), in order."""
+    raw = os.environ.get(PREFER_ENV, "")
+    return tuple(part.strip().lower() for part in raw.split(",") if part.strip())
+
+
+def _preferred(formats: list[FormatSpec]) -> FormatSpec | None:
+    by_name = {spec.name: spec for spec in formats}
+    for name in preferred_formats():
+        if name in by_name:
+            return by_name[name]
+    return None
+
+
+def break_tie(formats: list[FormatSpec]) -> list[FormatSpec]:
+    """Of formats matching a file equally: the first preferred one, else the built-in ones.
+
+    A plugin's format overrides a built-in one only when asked: by ``format=`` or by naming
+    it in ``GEOBREP_PREFER_FORMATS``.
+
+    Example:
+        >>> own = FormatSpec(name="own", extensions=(".x",), reader=print, builtin=True)
+        >>> other = FormatSpec(name="other", extensions=(".x",), reader=print, plugin="p")
+        >>> [spec.name for spec in break_tie([other, own])]
+        ['own']
+    """
+    if len(formats) < 2:
+        return formats
+    preferred = _preferred(formats)
+    if preferred is not None:
+        return [preferred]
+    own = [spec for spec in formats if spec.builtin]
+    return own or formats
 
 
 def _longest_match(formats: list[FormatSpec], path: Path) -> list[FormatSpec]:
@@ -730,14 +816,14 @@ class Registries:
     KINDS: ClassVar[tuple[str, ...]] = ("formats", "clippers", "fitters", "builders", "voxelizers")
 
     @classmethod
-    def staging(cls, plugin: str) -> Registries:
-        """Empty registries that stamp each added item with ``plugin``."""
+    def staging(cls, plugin: str, *, builtin: bool = False) -> Registries:
+        """Empty registries that stamp each added item with ``plugin`` and ``builtin``."""
         return cls(
-            formats=FormatRegistry(plugin=plugin),
-            clippers=ClipperRegistry(plugin=plugin),
-            fitters=FitterRegistry(plugin=plugin),
-            builders=BuilderRegistry(plugin=plugin),
-            voxelizers=VoxelizerRegistry(plugin=plugin),
+            formats=FormatRegistry(plugin=plugin, builtin=builtin),
+            clippers=ClipperRegistry(plugin=plugin, builtin=builtin),
+            fitters=FitterRegistry(plugin=plugin, builtin=builtin),
+            builders=BuilderRegistry(plugin=plugin, builtin=builtin),
+            voxelizers=VoxelizerRegistry(plugin=plugin, builtin=builtin),
         )
 
     def by_kind(self) -> dict[str, Registry[Any]]:
