@@ -18,16 +18,24 @@ per-file work on a Dask cluster (a ``dask.distributed.Client`` or a scheduler ad
 from __future__ import annotations
 
 import glob
+import multiprocessing
+import multiprocessing.connection
 import re
+import signal
 import time
+from collections import deque
 from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from multiprocessing.connection import Connection
+from multiprocessing.context import DefaultContext
 from os import PathLike
 from pathlib import Path
 from typing import Any, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict
 
+from geobrep.batch.outputs import OutputFolder, check_file_name, contained
 from geobrep.errors import FileAccessError, FormatError, GeobrepError, OptionsError, import_optional
 from geobrep.host.capabilities import (
     format_losses,
@@ -42,12 +50,14 @@ from geobrep.ops.io import read, write
 __all__ = [
     "ConversionSummary",
     "FileReport",
+    "WorkerDiedError",
     "convert",
     "convert_file",
     "demo_stage",
     "expand",
     "run_each",
     "verify_read_back",
+    "worker_failure",
 ]
 
 PathArg = str | PathLike[str]
@@ -141,11 +151,13 @@ def convert_file(
     write_format: str | None = None,
     write_options: dict[str, Any] | None = None,
     verify: bool = False,
+    out_dir: Path | None = None,
 ) -> FileReport:
     """Convert one file; never raises: a failure is a report with ``error`` set.
 
     ``verify`` reads the written file back: anything missing that the report does not list
-    as lost makes the file fail.
+    as lost makes the file fail. With ``out_dir``, ``target`` must resolve inside that folder
+    when it is written (see :func:`geobrep.batch.outputs.contained`).
     """
     started = time.perf_counter()
     try:
@@ -155,6 +167,8 @@ def convert_file(
         spec = registries().formats.choose_writer(target, write_format)
         lost = format_losses(scene, spec, target)
         scene = without_read_losses(scene)  # it describes the source, not what is written
+        if out_dir is not None:
+            contained(target, out_dir)  # planned inside; still inside now (symlinks)?
         write(scene, target, format=spec.name, **(write_options or {}))
         if verify:
             try:
@@ -260,8 +274,9 @@ def _targets(
     output: Path | None,
     to: str | None,
     out_dir: Path | None,
-) -> list[Path | None]:
-    """Where each source goes; None for a source whose name clashes with an earlier one."""
+) -> tuple[list[Path | str], Path | None]:
+    """Where each source goes, or why it cannot go (its name clashes with an earlier one, or
+    its path resolves outside the output folder); and the output folder (None: one file)."""
     if out_dir is None and output is not None and (to is not None or output.is_dir()):
         out_dir = output
         output = None
@@ -270,7 +285,7 @@ def _targets(
             raise OptionsError(
                 f"{len(sources)} inputs need an output folder (out_dir=...) and a format (to=...)"
             )
-        return [output]
+        return [output], None
     if out_dir is None:
         raise OptionsError("give an output file, or out_dir=... with to=... for many files")
     if to is None:
@@ -289,14 +304,20 @@ def _targets(
         extension = spec.extensions[0] if spec.extensions else f".{spec.name}"
     else:  # an extension (`ml`, `.vtu`): kept as given, so `ml` writes a Model3d, not a TSurf
         extension = "." + to.lstrip(".").lower()
+        check_file_name("x" + extension)  # an extension, never a path
         formats.choose_writer(Path(f"x{extension}"))
-    targets: list[Path | None] = []
+    folder = OutputFolder(out_dir)
+    targets: list[Path | str] = []
     seen: set[Path] = set()
     for source in sources:
-        target = out_dir / (source.name.split(".")[0] + extension)
-        targets.append(None if target in seen else target)
+        try:
+            target = folder.target(source.name.split(".")[0] + extension)
+        except GeobrepError as exc:
+            targets.append(str(exc))
+            continue
+        targets.append("another input has the same output name" if target in seen else target)
         seen.add(target)
-    return targets
+    return targets, out_dir
 
 
 def convert(
@@ -330,32 +351,32 @@ def convert(
         raise OptionsError(f"jobs must be at least 1, got {jobs}")
     sources = expand(inputs)
     target_dir = None if out_dir is None else Path(out_dir)
-    targets = _targets(sources, None if output is None else Path(output), to, target_dir)
+    targets, folder = _targets(sources, None if output is None else Path(output), to, target_dir)
     write_format = None
     if to is not None:
         from geobrep.host import registries
 
         formats = registries().formats
         write_format = to if to in formats else None
-    work = [(s, t) for s, t in zip(sources, targets, strict=True) if t is not None]
+    work = [(s, t) for s, t in zip(sources, targets, strict=True) if isinstance(t, Path)]
     results: dict[int, FileReport] = {}
     total = len(sources)
     for index, (source, target) in enumerate(zip(sources, targets, strict=True)):
-        if target is None:
-            results[index] = _failed(source, None, "another input has the same output name", 0.0)
+        if isinstance(target, str):
+            results[index] = _failed(source, None, target, 0.0)
 
     def done(index: int, report: FileReport) -> None:
         results[index] = report
         if progress is not None:
             progress(report, len(results), total)
 
-    indices = [i for i, t in enumerate(targets) if t is not None]
-    arguments = [(s, t, read_format, write_format, write_options, verify) for s, t in work]
+    indices = [i for i, t in enumerate(targets) if isinstance(t, Path)]
+    arguments = [(s, t, read_format, write_format, write_options, verify, folder) for s, t in work]
 
     def finished(position: int, report: FileReport | None, error: BaseException | None) -> None:
         if report is None:  # the worker died (killed, out of memory)
             source, target = arguments[position][:2]
-            report = _failed(source, target, f"worker failed: {type(error).__name__}", 0.0)
+            report = _failed(source, target, worker_failure(error), 0.0)
         done(indices[position], report)
 
     run_each(convert_file, arguments, finished, jobs=jobs if len(work) > 1 else 1, client=client)
@@ -387,24 +408,144 @@ def run_each(
             done(position, function(*args), None)
 
 
+class WorkerDiedError(GeobrepError):
+    """A worker process died under one call (a crash, a signal, the out-of-memory killer).
+
+    >>> str(WorkerDiedError(-9))
+    'worker died (signal 9, SIGKILL)'
+    """
+
+    def __init__(self, exitcode: int | None) -> None:
+        self.exitcode = exitcode
+        if exitcode is None:
+            status = "no exit status"
+        elif exitcode < 0:
+            try:
+                status = f"signal {-exitcode}, {signal.Signals(-exitcode).name}"
+            except ValueError:
+                status = f"signal {-exitcode}"
+        else:
+            status = f"exit code {exitcode}"
+        super().__init__(f"worker died ({status})")
+
+
+def worker_failure(error: BaseException | None) -> str:
+    """What a report says of a call that returned nothing: its worker died, or raised.
+
+    >>> worker_failure(WorkerDiedError(1))
+    'worker died (exit code 1)'
+    """
+    if isinstance(error, WorkerDiedError):
+        return str(error)
+    text = f"worker failed: {type(error).__name__}"
+    return f"{text}: {error}" if str(error) else text
+
+
+Done = Callable[[int, R | None, BaseException | None], None]
+
+
 def _run_processes(
+    jobs: int, function: Callable[..., R], arguments: Sequence[tuple[Any, ...]], done: Done[R]
+) -> None:
+    """Run the calls in a pool of ``jobs`` processes; a worker's death costs only its call.
+
+    At most ``2 * jobs`` calls are in the pool at a time. When a worker dies the pool is broken
+    and every call in it fails: those calls (the suspects) are run again, each in a process of
+    its own, which tells the one that kills its worker (reported as :class:`WorkerDiedError`
+    with the exit status) from the innocent; then a new pool takes the rest.
+    """
+    context = multiprocessing.get_context()
+    waiting = deque(range(len(arguments)))
+    while waiting:
+        suspects = _pool_round(jobs, context, function, arguments, waiting, done)
+        for start in range(0, len(suspects), jobs):
+            _run_alone(context, function, arguments, suspects[start : start + jobs], done)
+
+
+def _pool_round(
     jobs: int,
+    context: DefaultContext,
     function: Callable[..., R],
     arguments: Sequence[tuple[Any, ...]],
-    done: Callable[[int, R | None, BaseException | None], None],
+    waiting: deque[int],
+    done: Done[R],
+) -> list[int]:
+    """Run waiting calls in one pool until they are done or it breaks; returns the suspects."""
+    suspects: list[int] = []
+    running: dict[Future[R], int] = {}
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
+        while waiting or running:
+            while waiting and len(running) < 2 * jobs and not suspects:
+                position = waiting.popleft()
+                try:
+                    running[pool.submit(function, *arguments[position])] = position
+                except BrokenProcessPool:
+                    waiting.appendleft(position)
+                    break
+            if not running:
+                break
+            finished, _ = wait(running, return_when=FIRST_COMPLETED)
+            for future in finished:
+                position = running.pop(future)
+                try:
+                    result = future.result()
+                except BrokenProcessPool:  # a worker died: this call, or another one in the pool
+                    suspects.append(position)
+                except Exception as exc:
+                    done(position, None, exc)
+                else:
+                    done(position, result, None)
+    return sorted(suspects)
+
+
+def _run_alone(
+    context: DefaultContext,
+    function: Callable[..., R],
+    arguments: Sequence[tuple[Any, ...]],
+    positions: Sequence[int],
+    done: Done[R],
 ) -> None:
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
-        futures = {
-            pool.submit(function, *args): position for position, args in enumerate(arguments)
-        }
-        for future in as_completed(futures):
-            position = futures[future]
+    """Run each call in a process of its own, at the same time; a death is that call's."""
+    started = {}
+    for position in positions:
+        receive, send = context.Pipe(duplex=False)
+        process = context.Process(
+            target=_call_and_send, args=(send, function, arguments[position]), daemon=True
+        )
+        process.start()
+        send.close()
+        started[receive] = (position, process)
+    while started:
+        for ready in multiprocessing.connection.wait(list(started)):
+            assert isinstance(ready, Connection)
+            position, process = started.pop(ready)
             try:
-                result = future.result()
-            except Exception as exc:  # the worker process died (e.g. killed, out of memory)
-                done(position, None, exc)
+                outcome, value = ready.recv()
+            except (EOFError, OSError):  # the process ended without an answer: it died
+                process.join()
+                done(position, None, WorkerDiedError(process.exitcode))
             else:
-                done(position, result, None)
+                process.join()
+                if outcome == "result":
+                    done(position, value, None)
+                else:
+                    done(position, None, value)
+            finally:
+                ready.close()
+
+
+def _call_and_send(send: Connection, function: Callable[..., Any], args: tuple[Any, ...]) -> None:
+    """In a child process: call ``function`` and send ``("result", value)`` or the exception."""
+    try:
+        message: tuple[str, Any] = ("result", function(*args))
+    except BaseException as exc:  # like a pool worker: the caller gets the exception
+        message = ("error", exc)
+    try:
+        send.send(message)
+    except Exception as exc:  # the result or the exception cannot be pickled
+        send.send(("error", RuntimeError(f"{type(exc).__name__}: {exc}")))
+    finally:
+        send.close()
 
 
 def _run_dask(

@@ -31,7 +31,6 @@ geobrep.errors.OptionsError: pipeline: step 1: unknown step kind 'clipp'; step k
 from __future__ import annotations
 
 import json
-import string
 from collections.abc import Mapping
 from os import PathLike
 from pathlib import Path
@@ -52,6 +51,8 @@ from pydantic import (
     model_validator,
 )
 
+from geobrep.batch.limits import MAX_FILE_BYTES, check_json_depth, load_yaml
+from geobrep.batch.outputs import NAME_FIELDS, check_name_pattern, format_name
 from geobrep.errors import FileAccessError, FormatError, GeobrepError, OptionsError
 
 if TYPE_CHECKING:
@@ -80,9 +81,6 @@ PathArg = str | PathLike[str]
 Plane4 = tuple[FiniteFloat, FiniteFloat, FiniteFloat, FiniteFloat]
 Bounds6 = tuple[FiniteFloat, FiniteFloat, FiniteFloat, FiniteFloat, FiniteFloat, FiniteFloat]
 Options = dict[str, JsonValue]
-
-#: Fields a write step's ``name`` pattern may use.
-NAME_FIELDS = ("stem", "name", "ext", "index")
 
 
 class StepOptions(BaseModel):
@@ -277,8 +275,9 @@ class VoxelizeStep(StepOptions):
 class WriteStep(StepOptions):
     """Write the scene as it is at this step (the scene flows on unchanged) to
     ``<output>/<name>``: ``format`` names a registered format, ``name`` a file-name pattern with
-    ``{stem}``, ``{name}``, ``{ext}``, ``{index}`` (default ``{stem}`` + the format's
-    extension); ``options`` are the format's. NURBS surfaces are tessellated when the format
+    the bare fields ``{stem}``, ``{name}``, ``{ext}``, ``{index}`` (default ``{stem}`` + the
+    format's extension; no attribute access, indexing or format spec, and the file must lie in
+    the output folder); ``options`` are the format's. NURBS surfaces are tessellated when the format
     cannot hold them (``tessellate``). Files appear only when the whole pipeline succeeded for
     that input."""
 
@@ -294,7 +293,7 @@ class WriteStep(StepOptions):
         if self.format is None and self.name is None:
             raise ValueError("give a format, a file name pattern (name), or both")
         if self.name is not None:
-            _check_pattern(self.name)
+            check_name_pattern(self.name)
         return self
 
     def pattern(self, registries: Registries) -> str:
@@ -308,7 +307,9 @@ class WriteStep(StepOptions):
         """The registered format this step writes with."""
         if self.format is not None:
             return self.format
-        sample = self.pattern(registries).format(stem="x", name="x.x", ext=".x", index=0)
+        sample = format_name(
+            self.pattern(registries), {"stem": "x", "name": "x.x", "ext": ".x", "index": 0}
+        )
         return registries.formats.choose_writer(Path(sample)).name
 
     def check(self, registries: Registries) -> None:
@@ -524,16 +525,26 @@ class Pipeline(BaseModel):
 
         Raises:
             FileAccessError: the file is missing or unreadable.
-            FormatError: not valid YAML/JSON (with the line).
+            FormatError: not valid YAML/JSON (with the line), or over a limit: larger than
+                ``MAX_FILE_BYTES`` (10 MB), nested deeper than ``MAX_DEPTH`` (64), or YAML
+                aliases beyond ``MAX_ALIASES`` (100) or ``MAX_ALIAS_NODES`` (100,000 nodes
+                added; see :mod:`geobrep.batch.limits`).
             OptionsError: the document is not a valid pipeline.
         """
         file = Path(path)
         try:
-            text = file.read_text(encoding="utf-8")
+            with file.open("rb") as stream:
+                raw = stream.read(MAX_FILE_BYTES + 1)
+            text = raw.decode("utf-8")
         except FileNotFoundError as exc:
             raise FileAccessError("no such file", file) from exc
         except (OSError, UnicodeDecodeError) as exc:
             raise FileAccessError(f"cannot be read ({exc})", file) from exc
+        if len(raw) > MAX_FILE_BYTES:
+            raise FormatError(
+                f"a pipeline file is at most {MAX_FILE_BYTES // 2**20} MB; this one is larger",
+                file,
+            )
         data = _parse(text, file)
         return cls.from_data(data, source=str(file)).with_base_dir(file.parent)
 
@@ -649,6 +660,7 @@ def option_names(step_type: type[StepOptions]) -> list[str]:
 
 def _parse(text: str, file: Path) -> Any:
     if file.suffix.lower() == ".json":
+        check_json_depth(text, file)
         try:
             return json.loads(text)
         except json.JSONDecodeError as exc:
@@ -656,27 +668,12 @@ def _parse(text: str, file: Path) -> Any:
     import yaml
 
     try:
-        return yaml.safe_load(text)
+        return load_yaml(text, file)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         problem = getattr(exc, "problem", None) or str(exc)
         line = mark.line + 1 if mark is not None else None
         raise FormatError(f"not valid YAML: {problem}", file, line) from exc
-
-
-def _check_pattern(pattern: str) -> None:
-    try:
-        fields = [f for _, f, _, _ in string.Formatter().parse(pattern) if f is not None]
-    except ValueError as exc:
-        raise ValueError(f"name pattern {pattern!r}: {exc}") from exc
-    for field in fields:
-        if field.split(".")[0].split("[")[0] not in NAME_FIELDS:
-            raise ValueError(
-                f"name pattern {pattern!r}: unknown field {{{field}}}; "
-                f"fields: {', '.join('{' + f + '}' for f in NAME_FIELDS)}"
-            )
-    if "/" in pattern or "\\" in pattern:
-        raise ValueError(f"name pattern {pattern!r}: a file name, not a path")
 
 
 def _get(registry: Any, name: str, option: str = "format") -> Any:

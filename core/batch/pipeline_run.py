@@ -29,7 +29,8 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict
 
-from geobrep.batch.conversion import expand, report_table, run_each
+from geobrep.batch.conversion import expand, report_table, run_each, worker_failure
+from geobrep.batch.outputs import OutputFolder, contained, format_name, name_fields
 from geobrep.batch.pipeline import (
     BuildBlocksStep,
     BuildStep,
@@ -156,18 +157,26 @@ def plan_outputs(
 ) -> list[tuple[Path, ...] | str]:
     """Per source, the file each write step produces; a message for a source that cannot run.
 
-    A name another source already claimed, or that is one of the inputs, is that source's
-    failure (the earlier source keeps the name).
+    Names come from :func:`geobrep.batch.outputs.format_name` and paths from
+    :class:`~geobrep.batch.outputs.OutputFolder`: a name that is not a plain file name, or a
+    path that resolves outside ``out_dir`` (through a symlink), is that source's failure. So is
+    a name another source already claimed, or that is one of the inputs (the earlier source
+    keeps the name).
     """
     patterns = [
         step.pattern(registries) for step in pipeline.step_list if isinstance(step, WriteStep)
     ]
+    folder = OutputFolder(out_dir)
     inputs = {source.resolve() for source in sources}
     owners: dict[Path, Path] = {}
     plans: list[tuple[Path, ...] | str] = []
     for index, source in enumerate(sources):
-        fields = {"stem": source.name.split(".")[0], "name": source.name, "index": index}
-        targets = tuple(out_dir / pattern.format(**fields) for pattern in patterns)
+        fields = name_fields(source, index)
+        try:
+            targets = tuple(folder.target(format_name(p, fields)) for p in patterns)
+        except GeobrepError as exc:
+            plans.append(str(exc))
+            continue
         problem = None
         for target in targets:
             key = target.resolve()
@@ -254,7 +263,7 @@ def run_pipeline(
     ) -> None:
         if report is None:  # the worker died (killed, out of memory)
             source = arguments[position][1]
-            message = f"worker failed: {type(error).__name__}: {error}"
+            message = worker_failure(error)
             report = PipelineFileReport(source=source, status="failed", error=message)
         done(indices[position], report)
 
@@ -347,6 +356,7 @@ def _write_outputs(work: _Work) -> dict[int, float]:
         for number, kind, target, scene, format_name, options in work.pending:
             work.number, work.kind = number, kind
             begun = time.perf_counter()
+            contained(target, target.parent)  # planned inside; still inside now (symlinks)?
             write(scene, target, format=format_name, **options)
             written.append(target)
             spent[number] = time.perf_counter() - begun
