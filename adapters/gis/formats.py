@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import importlib
 import json
+import os
 import re
 import shutil
-import tempfile
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -41,6 +41,7 @@ from geobrep.gis.map_products import SECTION_FRAME_KEY
 from geobrep.host.registry import FormatSpec
 from geobrep.model.crs import CRS
 from geobrep.model.scene import Scene
+from geobrep.ops.temporaries import temporary_path
 
 __all__ = ["GisOptions", "gis_formats", "looks_like_geojson", "read_gis", "write_gis"]
 
@@ -52,6 +53,9 @@ LAYER_COLUMN = "layer"
 _GEOMETRY_TYPES = {0: "Point Z", 1: "LineString Z", 2: "LineString Z", 3: "Polygon Z"}
 _DRIVERS = {"gpkg": "GPKG", "geojson": "GeoJSON", "shapefile": "ESRI Shapefile"}
 _SHAPEFILE_SIDECARS = (".shx", ".dbf", ".prj", ".cpg")
+#: Files that belong to one .shp and are replaced with it: its sidecars and spatial indexes
+#: (a .qix/.sbn of the old geometry would mislead a reader of the new one).
+_SHAPEFILE_REPLACED = (*_SHAPEFILE_SIDECARS, ".qix", ".sbn", ".sbx")
 
 
 class GisOptions(ReadOptions):
@@ -75,7 +79,7 @@ def _pyogrio() -> Any:
 
 def _final_name(path: Path) -> Path:
     """The name the user asked for, from a temporary name of :func:`geobrep.ops.io.atomic_write`."""
-    return path.with_name(re.sub(r"^\.(.*)\.tmp-[0-9a-f]+(\.[^.]*)?$", r"\1\2", path.name))
+    return path.with_name(re.sub(r"^\.(.*)\.tmp-[0-9]+-[0-9a-f]{8}(\.[^.]*)?$", r"\1\2", path.name))
 
 
 def looks_like_geojson(head: bytes) -> bool:
@@ -155,6 +159,8 @@ def _shapefile_columns(columns: dict[str, NDArray[Any]]) -> dict[str, NDArray[An
 
 def _read_layer(path: Path, layer: str, driver: str) -> tuple[list[FeatureTable], str | None]:
     pyogrio = _pyogrio()
+    if driver == "ESRI Shapefile" and path.suffix.lower() == ".shp":
+        check_shapefile_set(path)
     meta, fids, geometry, field_data = pyogrio.raw.read(path, layer=layer, return_fids=True)
     columns = {str(name): values for name, values in zip(meta["fields"], field_data, strict=True)}
     if driver == "ESRI Shapefile":
@@ -393,24 +399,84 @@ def _raw_write(pyogrio: Any, path: Path, *args: Any, **kwargs: Any) -> None:
 
 
 def _shapefile_write(table: FeatureTable, path: Path, crs: CRS | None) -> None:
-    """Write a shapefile set: ``path`` is the (temporary) .shp; sidecars get the final stem."""
-    final_stem = _final_name(path).stem
+    """Write a shapefile set: ``path`` is the (temporary) .shp; sidecars get the final stem.
+
+    The set is written whole into a staging folder beside the target, then put in place so that
+    a reader opening the .shp finds the old set, the new set, or no .shp at all: the old .shp
+    goes first (into the staging folder), then the new sidecars replace the old ones (and old
+    sidecars the new set lacks are removed), and the new .shp comes last (``atomic_write``
+    renames ``path`` onto it). See docs/security.md, "Interrupted writes".
+    """
+    final = _final_name(path)
     long_names = [n for n in table.columns if len(n) > 10 and n not in RESERVED_COLUMNS]
     if long_names:
         warnings.warn(
-            f"{_final_name(path)}: shapefile field names are cut to 10 "
-            f"characters: {', '.join(long_names)}",
+            f"{final}: shapefile field names are cut to 10 characters: {', '.join(long_names)}",
             FeatureWarning,
             stacklevel=4,
         )
-    with tempfile.TemporaryDirectory(dir=path.parent, prefix=".shp-") as folder:
-        staging = Path(folder) / f"{final_stem}.shp"
+    folder = temporary_path(final, ".set")
+    folder.mkdir()
+    try:
+        staging = folder / f"{final.stem}.shp"
         _write_tables([table], staging, "ESRI Shapefile", crs)
-        for sidecar in _SHAPEFILE_SIDECARS:
-            produced = staging.with_suffix(sidecar)
-            if produced.exists():
-                shutil.move(str(produced), str(path.with_name(final_stem + sidecar)))
-        shutil.move(str(staging), str(path))
+        _replace_set(staging, final, folder)
+        os.replace(staging, path)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _replace_set(staging: Path, final: Path, folder: Path) -> None:
+    """Take the old .shp away, then put the new sidecars (and only them) beside ``final``."""
+    if final.exists():
+        os.replace(final, folder / "replaced.shp")
+    for sidecar in _SHAPEFILE_REPLACED:
+        produced = staging.with_suffix(sidecar)
+        target = final.with_suffix(sidecar)
+        if produced.exists():
+            os.replace(produced, target)
+        elif target.exists():
+            target.unlink()  # the old set's: it would pair with the new .shp
+
+
+def check_shapefile_set(path: Path) -> None:
+    """Refuse a shapefile whose .shp, .shx and .dbf do not describe the same records.
+
+    Catches a set mixed from two writes (by a tool that does not replace sets whole, or a
+    reader racing a replacement): the .shp length in its header, the .shx index and the .dbf
+    record count must agree. A missing .shx or .dbf is left to GDAL.
+
+    Raises:
+        FormatError: naming the files that disagree.
+    """
+    index, table = path.with_suffix(".shx"), path.with_suffix(".dbf")
+    if not (path.is_file() and index.is_file() and table.is_file()):
+        return
+    with path.open("rb") as shp, index.open("rb") as shx, table.open("rb") as dbf:
+        shp_words = _big_int(shp.read(100), 24)
+        shx_head = shx.read(100)
+        shx_records = (_big_int(shx_head, 24) * 2 - 100) // 8
+        dbf_head = dbf.read(8)
+        dbf_records = int.from_bytes(dbf_head[4:8], "little") if len(dbf_head) == 8 else -1
+        if shx_records > 0:
+            shx.seek(100 + 8 * (shx_records - 1))
+            last = shx.read(8)
+            shp_end = (_big_int(last, 0) + _big_int(last, 4)) * 2 + 8 if len(last) == 8 else -1
+        else:
+            shp_end = 100
+    size = path.stat().st_size
+    if shp_words * 2 != size or shx_records != dbf_records or shp_end != size:
+        raise FormatError(
+            f"the shapefile set does not fit together ({path.name}: {size} bytes, its header "
+            f"says {shp_words * 2}; {index.name}: {shx_records} records ending at byte "
+            f"{shp_end}; {table.name}: {dbf_records} records): a mix of two writes?",
+            path,
+        )
+
+
+def _big_int(data: bytes, offset: int) -> int:
+    chunk = data[offset : offset + 4]
+    return int.from_bytes(chunk, "big", signed=True) if len(chunk) == 4 else -1
 
 
 def _plane_frames(

@@ -31,6 +31,7 @@ COMMAND_MODULES = (
     "voxelize",
     "fit",
     "run",
+    "clean",
 )
 
 

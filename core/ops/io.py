@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import os
 import re
-import secrets
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from os import PathLike
@@ -22,6 +21,7 @@ from typing import Any
 from geobrep.errors import FileAccessError, FormatError, GeobrepError, UnknownFormatError
 from geobrep.model.entities import Entity
 from geobrep.model.scene import Scene
+from geobrep.ops.temporaries import remove_stale_temporaries, temporary_path
 
 __all__ = ["as_scene", "atomic_write", "read", "write"]
 
@@ -32,8 +32,11 @@ PathArg = str | PathLike[str]
 def atomic_write(path: PathArg) -> Iterator[Path]:
     """Yield a temporary path beside ``path``; rename it onto ``path`` only on success.
 
-    The temporary name keeps the final suffix, so writers that look at it still work. On an
-    exception the temporary file is removed and ``path`` is left as it was.
+    The temporary is ``.{stem}.tmp-{pid}-{random}{suffix}``: it keeps the final suffix, so
+    writers that look at it still work, and names the writing process, so that temporaries
+    left by a killed process are found later: each call first removes the stale temporaries of
+    ``path`` (:mod:`geobrep.ops.temporaries`; also ``geobrep clean FOLDER``). On an exception
+    the temporary file is removed and ``path`` is left as it was.
 
     >>> import tempfile, pathlib
     >>> target = pathlib.Path(tempfile.mkdtemp()) / "out.txt"
@@ -45,8 +48,8 @@ def atomic_write(path: PathArg) -> Iterator[Path]:
     final = Path(path)
     if not final.parent.is_dir():
         raise FileAccessError("the output folder does not exist", final.parent)
-    token = secrets.token_hex(4)
-    temporary = final.with_name(f".{final.stem}.tmp-{token}{''.join(final.suffixes[-1:])}")
+    remove_stale_temporaries(final)
+    temporary = temporary_path(final)
     try:
         yield temporary
         if not temporary.exists():
@@ -152,13 +155,13 @@ def write(
 def _point_to_target(error: GeobrepError, target: Path) -> None:
     """Make an error raised while writing a temporary file name ``target`` instead.
 
-    The writer only sees :func:`atomic_write`'s temporary path (``.out.tmp-1530bb30.vtu``, or
-    ``..out.tmp-….tmp-….vtu`` when the writer writes atomically too), so its messages and
+    The writer only sees :func:`atomic_write`'s temporary path (``.out.tmp-4242-1530bb30.vtu``,
+    or ``..out.tmp-….tmp-….vtu`` when the writer writes atomically too), so its messages and
     ``path`` attributes name it: the user asked for ``out.vtu``.
     """
     suffix = "".join(target.suffixes[-1:])
     temporary = re.compile(
-        r"\.+" + re.escape(target.stem) + r"(?:\.tmp-[0-9a-f]{8})+" + re.escape(suffix)
+        r"\.+" + re.escape(target.stem) + r"(?:\.tmp-[0-9]+-[0-9a-f]{8})+" + re.escape(suffix)
     )
 
     def fixed(value: object) -> object:

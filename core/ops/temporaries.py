@@ -1,0 +1,180 @@
+"""Temporary files of interrupted writes: their names, whose they are, and removing stale ones.
+
+:func:`geobrep.ops.io.atomic_write` writes ``model.vtu`` through ``.model.tmp-{pid}-{random}.vtu``
+beside it (``{pid}`` is the writing process, ``{random}`` 8 hex digits) and renames it into
+place. A process that is killed leaves its temporary behind; the next :func:`atomic_write` of
+the same target, or ``geobrep clean FOLDER``, removes it once its process is gone.
+
+A temporary is **stale** when no process with its pid runs, or when the process that has that
+pid started after the file was last modified (the pid was reused). Only processes of this
+machine (and PID namespace) can be seen: do not clean a folder that a writer on another machine
+is writing into. On Windows nothing is considered stale.
+
+Example:
+    >>> parse_temporary(".model.tmp-4242-0a1b2c3d.vtu")
+    (4242, 'model')
+    >>> parse_temporary("model.vtu") is None
+    True
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import secrets
+import shutil
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+__all__ = [
+    "TEMPORARY_PATTERN",
+    "Temporary",
+    "find_temporaries",
+    "parse_temporary",
+    "remove_stale_temporaries",
+    "temporary_path",
+]
+
+TEMPORARY_PATTERN = re.compile(
+    r"^\.(?P<stem>.+)\.tmp-(?P<pid>[1-9][0-9]{0,9})-(?P<token>[0-9a-f]{8})(?P<suffix>\.[^.]+)?$"
+)
+"""The name of a geobrep temporary: ``.{stem}.tmp-{pid}-{8 hex digits}{suffix}``."""
+
+_SLACK = 2.0
+"""Seconds of doubt between a file's time and a process's start (boot time has 1 s steps)."""
+
+
+def temporary_path(final: Path, suffix: str | None = None) -> Path:
+    """A fresh temporary name beside ``final`` for this process (``suffix``: final's by default).
+
+    >>> temporary_path(Path("out/model.vtu")).name.startswith(".model.tmp-")
+    True
+    """
+    ending = "".join(final.suffixes[-1:]) if suffix is None else suffix
+    token = secrets.token_hex(4)
+    return final.with_name(f".{final.stem}.tmp-{os.getpid()}-{token}{ending}")
+
+
+def parse_temporary(name: str) -> tuple[int, str] | None:
+    """``(pid, stem)`` of a temporary's file name, or ``None`` if it is not one."""
+    match = TEMPORARY_PATTERN.match(name)
+    if match is None:
+        return None
+    return int(match["pid"]), match["stem"].lstrip(".").split(".tmp-")[0]
+
+
+def _process_start(pid: int) -> float | None:
+    """When process ``pid`` started (seconds since the epoch), where the system says (Linux)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+        boot = next(
+            line for line in Path("/proc/stat").read_text().splitlines() if line.startswith("btime")
+        )
+        ticks = int(stat.rsplit(")", 1)[1].split()[19])
+        return int(boot.split()[1]) + ticks / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError, StopIteration):
+        return None
+
+
+def _owner_running(pid: int, modified: float) -> bool:
+    """Whether the process that wrote a temporary last modified at ``modified`` still runs."""
+    if os.name == "nt":
+        return True  # os.kill would end the process; assume it runs
+    if pid != os.getpid():
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        except (PermissionError, OverflowError):
+            return pid > 0  # another user's process (or a pid out of range: none)
+        except OSError:
+            return True
+    start = _process_start(pid)
+    return start is None or modified >= start - _SLACK
+
+
+@dataclass(frozen=True)
+class Temporary:
+    """A geobrep temporary found in a folder."""
+
+    path: Path
+    pid: int
+    stale: bool
+    size: int
+
+    @property
+    def reason(self) -> str:
+        """Why it is stale or kept, in words."""
+        if self.stale:
+            return f"process {self.pid} is gone"
+        return f"process {self.pid} is running"
+
+
+def _size(path: Path) -> int:
+    try:
+        if path.is_dir() and not path.is_symlink():
+            return sum(p.stat().st_size for p in path.rglob("*") if p.is_file())
+        return path.lstat().st_size
+    except OSError:
+        return 0
+
+
+def _examine(path: Path) -> Temporary | None:
+    parsed = parse_temporary(path.name)
+    if parsed is None:
+        return None
+    try:
+        modified = path.lstat().st_mtime
+    except OSError:
+        return None  # gone meanwhile
+    stale = not _owner_running(parsed[0], modified)
+    return Temporary(path=path, pid=parsed[0], stale=stale, size=_size(path))
+
+
+def _entries(folder: Path, recursive: bool) -> Iterator[Path]:
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return
+    for entry in entries:
+        if entry.name.startswith(".") and ".tmp-" in entry.name:
+            yield Path(entry.path)
+        elif recursive and entry.is_dir(follow_symlinks=False):
+            yield from _entries(Path(entry.path), recursive)
+
+
+def find_temporaries(folder: Path | str, *, recursive: bool = False) -> list[Temporary]:
+    """The geobrep temporaries in ``folder`` (and below, if ``recursive``), by path."""
+    found = (_examine(path) for path in _entries(Path(folder), recursive))
+    return sorted((t for t in found if t is not None), key=lambda t: str(t.path))
+
+
+def remove(temporary: Temporary) -> bool:
+    """Delete a temporary (a file, or a folder of a shapefile set); False if that failed."""
+    try:
+        if temporary.path.is_dir() and not temporary.path.is_symlink():
+            shutil.rmtree(temporary.path)
+        else:
+            temporary.path.unlink()
+    except FileNotFoundError:
+        return True
+    except OSError:
+        return False
+    return True
+
+
+def remove_stale_temporaries(final: Path) -> list[Path]:
+    """Remove the stale temporaries of target ``final`` (any suffix); the paths removed.
+
+    Best effort: a temporary that cannot be removed is left for ``geobrep clean``.
+    """
+    prefix = f"{final.stem}.tmp-"
+    removed: list[Path] = []
+    for path in _entries(final.parent, recursive=False):
+        if not path.name.lstrip(".").startswith(prefix):
+            continue
+        temporary = _examine(path)
+        if temporary is not None and temporary.stale and remove(temporary):
+            removed.append(path)
+    return removed
