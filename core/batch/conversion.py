@@ -509,9 +509,7 @@ def _run_alone(
     started = {}
     for position in positions:
         receive, send = context.Pipe(duplex=False)
-        process = context.Process(
-            target=_call_and_send, args=(send, function, arguments[position]), daemon=True
-        )
+        process = context.Process(target=_call_and_send, args=(send, function, arguments[position]))
         process.start()
         send.close()
         started[receive] = (position, process)
