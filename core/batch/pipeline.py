@@ -287,6 +287,9 @@ class WriteStep(StepOptions):
     name: str | None = None
     options: Options = Field(default_factory=dict)
     tessellate: bool = True
+    allow_empty: bool = False
+    """Write a scene with nothing in it (by default that fails the input: a clip that missed
+    the model should not pass for a result)."""
 
     @model_validator(mode="after")
     def _target(self) -> WriteStep:
@@ -493,6 +496,18 @@ class Pipeline(BaseModel):
     def base_dir(self) -> Path | None:
         """The folder of the pipeline file (None for a pipeline built in Python)."""
         return self._base_dir
+
+    def allowing_empty(self) -> Pipeline:
+        """This pipeline with every write step writing empty results too (``--allow-empty``)."""
+        steps = [
+            entry.model_copy(update={"write": entry.body.model_copy(update={"allow_empty": True})})
+            if isinstance(entry.body, WriteStep)
+            else entry
+            for entry in self.steps
+        ]
+        copy = self.model_copy(update={"steps": tuple(steps)})
+        copy._base_dir, copy._source = self._base_dir, self._source
+        return copy
 
     def with_base_dir(self, folder: PathArg | None) -> Pipeline:
         """This pipeline with relative paths resolved against ``folder``."""

@@ -481,6 +481,12 @@ def _voxelize(step: VoxelizeStep, scene: Scene, work: _Work) -> Applied:
 
 def _write(step: WriteStep, scene: Scene, work: _Work) -> Applied:
     target = work.targets[len(work.pending)]
+    if scene.bounds is None and not step.allow_empty:  # nothing with geometry in it
+        raise GeobrepError(
+            f"{target.name}: the result holds nothing to write (a clip or section that misses "
+            "the model?); give the write step allow_empty: true (geobrep run --allow-empty) to "
+            "write it anyway"
+        )
     format_name = step.format_name(work.registries)
     spec = work.registries.formats.get(format_name)
     caps = spec.capabilities

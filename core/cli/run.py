@@ -49,6 +49,11 @@ def add_parser(subparsers: Any) -> None:
         action="store_true",
         help="validate the pipeline and list the inputs; run nothing",
     )
+    parser.add_argument(
+        "--allow-empty",
+        action="store_true",
+        help="write results with nothing in them (by default such an input fails)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--json", action="store_true", help="print the reports as JSON")
     parser.set_defaults(run=run)
@@ -60,6 +65,8 @@ def run(args: argparse.Namespace) -> int:
     from geobrep.batch.pipeline_run import run_pipeline
 
     pipeline = Pipeline.load(args.pipeline).check()
+    if args.allow_empty:
+        pipeline = pipeline.allowing_empty()
     inputs = list(args.inputs) or None
     if args.check:
         base = pipeline.base_dir or Path.cwd()

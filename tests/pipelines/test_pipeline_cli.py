@@ -90,3 +90,26 @@ def test_a_bad_pipeline_is_one_error_line(
 def test_run_is_in_the_help(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["--help"]) == 0
     assert "run a pipeline file" in capsys.readouterr().out
+
+
+MISSING = """\
+inputs: [models/*.geobrep]
+output: out
+steps:
+  - clip: {plane: [1, 0, 0, -1.0e9], keep: positive}
+  - write: {format: native}
+"""
+
+
+def test_an_empty_result_fails_its_input_unless_allowed(
+    tmp_path: Path, cake_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A clip plane that misses the model leaves nothing: that is not a result (issue 12/7)."""
+    path = tmp_path / "missing.yaml"
+    path.write_text(MISSING, encoding="utf-8")
+    assert main(["run", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert "holds nothing to write" in out
+    assert not (tmp_path / "out" / "cake.geobrep").exists()
+    assert main(["run", str(path), "--allow-empty"]) == 0
+    assert (tmp_path / "out" / "cake.geobrep").is_file()
