@@ -20,14 +20,18 @@ from __future__ import annotations
 
 import itertools
 import json
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any, Final, cast
+from typing import Any, Final, Literal, cast
 
 import numpy as np
 from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, NonNegativeInt, ValidationError
 
-from geobrep.errors import EntityValidationError, FormatError
+from geobrep.adapters import strict_json
+from geobrep.adapters.casting import cast_exactly, misfit_rows
+from geobrep.errors import FormatError, GeobrepError
 from geobrep.model.crs import CRS
 from geobrep.model.entities import Entity, PointSet, PolyLine, Surface, TetMesh
 from geobrep.model.properties import Property, PropertyMap
@@ -40,10 +44,12 @@ __all__ = [
     "PART_ARRAY",
     "CellLayout",
     "chain_segments",
+    "check_header",
     "decode_header",
     "encode_header",
     "header_applies",
     "layout_to_scene",
+    "located",
     "scene_to_layout",
 ]
 
@@ -60,6 +66,7 @@ HEADER_VERSION: Final = 1
 LAYOUT_TYPES: Final = frozenset({"PointSet", "PolyLine", "Surface", "TetMesh"})
 
 _CELL_WIDTH: Final = {"vertex": 1, "line": 2, "triangle": 3, "quad": 4, "tetra": 4}
+_EMPTY_WIDTH: Final = {"Surface": 3, "TetMesh": 4, "PolyLine": 2, "PointSet": 1}
 
 
 @dataclass
@@ -99,8 +106,11 @@ def decode_header(data: Any) -> dict[str, Any] | None:
         if isinstance(data, str):
             text = data
         else:
-            text = np.asarray(data).astype(np.uint8).ravel().tobytes().decode("utf-8")
-        header = json.loads(text)
+            raw = np.asarray(data).ravel()
+            if misfit_rows(raw, np.uint8).any():
+                return None
+            text = raw.astype(np.uint8).tobytes().decode("utf-8")
+        header = strict_json.loads(text)
     except (ValueError, TypeError, UnicodeDecodeError):
         return None
     if not isinstance(header, dict) or header.get("format") != HEADER_FORMAT:
@@ -133,7 +143,9 @@ def header_applies(header: dict[str, Any] | None, cell_data: dict[str, Any]) -> 
     """True when ``header`` describes these cells: entity ids present, or a single entity."""
     if header is None:
         return False
-    return ENTITY_ARRAY in cell_data or len(header.get("entities", ())) <= 1
+    entities = header.get("entities", ())
+    # a header whose entities are not a list still claims the file: check_header says why not
+    return ENTITY_ARRAY in cell_data or not isinstance(entities, list) or len(entities) <= 1
 
 
 def _entity_cells(entity: Entity) -> tuple[str, NDArray[np.int64], NDArray[np.int64] | None]:
@@ -343,6 +355,80 @@ def _concat_points(arrays: list[NDArray[np.float64]]) -> NDArray[np.float64]:
 # -- layout -> scene ---------------------------------------------------------------------------
 
 
+class _PropertyRecord(BaseModel):
+    model_config = ConfigDict(extra="allow")
+    array: str
+    dtype: str
+
+
+class _EntityRecord(BaseModel):
+    model_config = ConfigDict(extra="allow")
+    id: int
+    type: Literal["PointSet", "PolyLine", "Surface", "TetMesh"]
+    points: tuple[NonNegativeInt, NonNegativeInt]
+    point_data: dict[str, _PropertyRecord] = {}
+    cell_data: dict[str, _PropertyRecord] = {}
+    part_offsets: list[NonNegativeInt] | None = None
+    closed: list[bool] | None = None
+
+
+class _HeaderRecord(BaseModel):
+    model_config = ConfigDict(extra="allow")
+    entities: list[_EntityRecord] = []
+    groups: list[dict[str, Any]] = []
+
+
+def _record_problem(record: _EntityRecord, n_points: int) -> str | None:
+    """What is wrong with one entity's header record, or None."""
+    start, stop = record.points
+    if not start <= stop <= n_points:
+        return f"points {start}..{stop} are not within the file's {n_points} points"
+    for kind in (record.point_data, record.cell_data):
+        for name, prop in kind.items():
+            try:
+                dtype = np.dtype(prop.dtype)
+            except (TypeError, ValueError):
+                return f"property {name!r}: dtype {prop.dtype!r} is not a numpy type"
+            if dtype.kind not in "biuf" or dtype.subdtype is not None:
+                return f"property {name!r}: dtype {prop.dtype!r} is not a number type"
+    if record.type == "PolyLine":
+        offsets, closed = record.part_offsets, record.closed
+        if offsets is None or closed is None:
+            return "a PolyLine record needs part_offsets and closed"
+        if offsets and (offsets[0] != 0 or offsets[-1] > stop - start):
+            return f"part_offsets must run from 0 to at most its {stop - start} points"
+        parts = max(len(offsets) - 1, 0)
+        if any(b < a for a, b in itertools.pairwise(offsets)) or len(closed) != parts:
+            return "part_offsets must not decrease and closed needs one flag per part"
+    return None
+
+
+def check_header(header: dict[str, Any], n_points: int, source: Any = None) -> None:
+    """Refuse a geobrep header that does not fit the ``n_points`` points of its file.
+
+    Every entity needs an id, a layout type and a range of points within the file, ranges of
+    different entities do not overlap (so nothing a header says can make a reader allocate
+    more than the file holds), property records name an array and a number dtype, polyline
+    parts cover their points. ``source`` (a path) names the file in the :class:`FormatError`.
+    """
+    try:
+        checked = _HeaderRecord.model_validate(header)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        where = ".".join(str(p) for p in first["loc"])
+        raise FormatError(f"geobrep header: {where}: {first['msg']}", source) from None
+    previous_stop = 0
+    for index, record in sorted(enumerate(checked.entities), key=lambda item: item[1].points):
+        problem = _record_problem(record, n_points)
+        if problem is None and record.points[0] < previous_stop:
+            problem = f"points {record.points[0]}..{record.points[1]} overlap another entity's"
+        if problem is not None:
+            raise FormatError(
+                f"geobrep header: entities.{index} (id {record.id}): {problem}", source
+            )
+        previous_stop = max(previous_stop, record.points[1])
+
+
 def layout_to_scene(layout: CellLayout, source: Any = None) -> Scene:
     """Rebuild a scene; with a header exactly, without one from the cell types.
 
@@ -355,19 +441,39 @@ def layout_to_scene(layout: CellLayout, source: Any = None) -> Scene:
         points = np.column_stack([points, np.zeros(len(points))])
     header = layout.header
     if header is not None and header_applies(header, layout.cell_data):
-        try:
-            return _scene_from_header(layout, points, header)
-        except EntityValidationError as exc:  # each entity checks its cells' vertex indices
-            raise FormatError(str(exc), source) from exc
-        except (KeyError, IndexError, TypeError, ValueError) as exc:
-            raise FormatError(f"inconsistent geobrep header: {exc}", source) from exc
+        check_header(header, len(points), source)
+        with located(source):
+            try:
+                return _scene_from_header(layout, points, header)
+            except (KeyError, IndexError, TypeError, ValueError) as exc:
+                if isinstance(exc, GeobrepError):
+                    raise
+                raise FormatError(f"inconsistent geobrep header: {exc}", source) from exc
     for kind, conn in layout.blocks:
         if conn.size and (conn.min() < 0 or conn.max() >= len(points)):
             raise FormatError(
                 f"{kind} cells refer to point {int(conn.max())} but there are {len(points)} points",
                 source,
             )
-    return _scene_from_cells(layout, points)
+    with located(source):
+        return _scene_from_cells(layout, points)
+
+
+@contextmanager
+def located(source: Any) -> Iterator[None]:
+    """Make every geobrep error raised inside a :class:`FormatError` naming ``source``.
+
+    An entity refusing what a file holds (NaN coordinates, an index past its vertices) says
+    which entity and field; the file it came from is added here.
+    """
+    try:
+        yield
+    except FormatError as exc:
+        if exc.path is not None or source is None:
+            raise
+        raise FormatError(exc.message, source, exc.line) from exc
+    except GeobrepError as exc:
+        raise FormatError(str(exc), source) from exc
 
 
 def _cells_of(layout: CellLayout, entity_id: int) -> tuple[str | None, NDArray[np.int64], Any]:
@@ -401,15 +507,19 @@ def _cells_of(layout: CellLayout, entity_id: int) -> tuple[str | None, NDArray[n
     return kind, conn_all, mask
 
 
+def _labels(values: Any, name: str = PART_ARRAY) -> NDArray[np.int64]:
+    """A label array of the file (patch, region, part or entity per cell) as int64 indices."""
+    return cast_exactly(np.asarray(values).ravel(), np.int64, f"cell array {name!r}")
+
+
 def _properties(
     records: dict[str, Any], arrays: dict[str, NDArray[Any]], index: Any
 ) -> PropertyMap:
     props: dict[str, Property] = {}
     for name, record in records.items():
-        values = np.asarray(arrays[record["array"]])[index]
-        dtype = np.dtype(record["dtype"])
-        if values.dtype != dtype:
-            values = values.astype(dtype)
+        values = cast_exactly(
+            np.asarray(arrays[record["array"]])[index], record["dtype"], f"property {name!r}"
+        )
         props[name] = Property(
             values=values,
             unit=record.get("unit"),
@@ -429,13 +539,15 @@ def _scene_from_header(
         start, stop = record["points"]
         vertices = points[start:stop]
         _kind, conn, mask = _cells_of(layout, int(record["id"]))
+        if conn.size == 0:  # an entity without cells: the width its type has
+            conn = conn.reshape(0, _EMPTY_WIDTH.get(record["type"], 1))
         if start:
             conn = conn - start  # the entity's own checks catch indices outside its points
         has_parts = record.get("has_patches") or record.get("has_regions")
         parts = (
             None
             if not has_parts
-            else np.asarray(parts_all).astype(np.int64).ravel()[mask]
+            else _labels(parts_all)[mask]
             if parts_all is not None
             else np.zeros(len(conn), np.int64)
         )
@@ -537,7 +649,7 @@ def _scene_from_cells(layout: CellLayout, points: NDArray[np.float64]) -> Scene:
     owners = (
         np.zeros(n_cells, np.int64)
         if owner_array is None or len(owner_array) != n_cells
-        else np.asarray(owner_array).astype(np.int64).ravel()
+        else _labels(owner_array, ENTITY_ARRAY)
     )
     part_array = layout.cell_data.get(PART_ARRAY)
     entities: list[Entity] = []
@@ -607,7 +719,7 @@ def _foreign_entity(
     if kind in ("triangle", "quad"):
         labels = None
         if part_array is not None and len(part_array) == n_cells:
-            labels = np.asarray(part_array).astype(np.int64).ravel()[mask]
+            labels = _labels(part_array)[mask]
         return Surface(
             vertices=vertices, faces=local, patch_labels=labels, cell_data=cell_data, **common
         )

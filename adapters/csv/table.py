@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -11,6 +12,7 @@ import numpy as np
 import orjson
 from numpy.typing import NDArray
 
+from geobrep.adapters.casting import misfit_rows
 from geobrep.errors import FileAccessError, FormatError, GeobrepError
 from geobrep.model.crs import CRS
 from geobrep.model.entities import PointSet
@@ -55,15 +57,52 @@ def _tokens(line: str) -> list[str]:
     return [token for token in _SPLIT.split(line.strip()) if token]
 
 
+class _Constant(str):
+    """``NaN``, ``Infinity`` or ``-Infinity`` as a metadata line spelled it (not JSON)."""
+
+
+def _misplaced_constant(data: Any, where: tuple[str, ...] = ()) -> str | None:
+    """Where ``data`` holds a :class:`_Constant` other than a property's no-data value.
+
+    Older geobrep wrote NaN no-data values as bare ``NaN``: those are read; anywhere else a
+    NaN would make the scene unwritable to JSON later.
+    """
+    if isinstance(data, _Constant):
+        allowed = len(where) == 3 and where[0] == "properties" and where[2] == "no_data_value"
+        return None if allowed else ".".join(where) or "(the line)"
+    items = (
+        data.items()
+        if isinstance(data, dict)
+        else enumerate(data)
+        if isinstance(data, list)
+        else ()
+    )
+    for key, value in items:
+        found = _misplaced_constant(value, (*where, str(key)))
+        if found is not None:
+            return found
+    return None
+
+
 def _metadata(line: str, path: Path, number: int) -> dict[str, Any]:
     try:
-        data = json.loads(line[len(METADATA_PREFIX) :])
+        data = json.loads(line[len(METADATA_PREFIX) :], parse_constant=_Constant)
+        misplaced = _misplaced_constant(data)
     except json.JSONDecodeError as exc:
         raise FormatError(
             f"the '# geobrep:' line is not valid JSON ({exc.msg})", path, number
         ) from None
+    except RecursionError:
+        raise FormatError("the '# geobrep:' line nests too deeply", path, number) from None
     if not isinstance(data, dict):
         raise FormatError("the '# geobrep:' line must hold a JSON object", path, number)
+    if misplaced is not None:
+        raise FormatError(
+            f"the '# geobrep:' line holds a NaN or infinity at {misplaced} (JSON has none; "
+            "only a property's no_data_value may be one)",
+            path,
+            number,
+        )
     return data
 
 
@@ -89,8 +128,38 @@ def _parse_rows(lines: list[tuple[int, str]], width: int, path: Path) -> NDArray
         raise FormatError("cannot parse the points", path) from None
 
 
+def _typed(
+    values: NDArray[np.float64], dtype: np.dtype[Any], columns: list[str], table: _Table
+) -> NDArray[Any]:
+    """``values`` as the integer or boolean ``dtype`` the metadata line declares, when every
+    value fits it; otherwise a FormatError naming the column and the line."""
+    bad = misfit_rows(values, dtype)
+    if bad.any():
+        row = int(np.argmax(bad))
+        column = int(np.argmax(misfit_rows(values[row : row + 1].T, dtype)))
+        raise FormatError(
+            f"column {columns[column]!r} holds {float(values[row, column])!r}, which does not "
+            f"fit the {dtype} its '# geobrep:' line declares",
+            table.path,
+            table.line_numbers[row],
+        )
+    return values.astype(dtype)
+
+
+@dataclass(frozen=True)
+class _Table:
+    """Where the rows of a points table come from: the file and the line of each row."""
+
+    path: Path
+    line_numbers: list[int]
+
+
 def _properties(
-    names: list[str], rows: NDArray[np.float64], xyz: list[int], meta: dict[str, Any]
+    names: list[str],
+    rows: NDArray[np.float64],
+    xyz: list[int],
+    meta: dict[str, Any],
+    table: _Table,
 ) -> dict[str, Property]:
     groups: dict[str, list[tuple[int, int]]] = {}
     for column, name in enumerate(names):
@@ -107,11 +176,12 @@ def _properties(
         info = described.get(base) or {}
         dtype = np.dtype(info.get("dtype", "float64"))
         if dtype.kind in "iub":
-            values = values.astype(dtype)
+            values = _typed(values, dtype, [names[column] for _, column in members], table)
+        no_data = info.get("no_data_value")
         result[base] = Property(
             values=values[:, 0] if len(members) == 1 else values,
             unit=info.get("unit"),
-            no_data_value=info.get("no_data_value"),
+            no_data_value=float(no_data) if isinstance(no_data, _Constant) else no_data,
         )
     return result
 
@@ -158,18 +228,21 @@ def read_points_table(path: Path) -> Scene:
     if bad.any():
         number = lines[int(np.argmax(bad))][0]
         raise FormatError("coordinates must be finite (NaN or inf found)", path, number)
+    table = _Table(path, [number for number, _ in lines])
     try:
         points = PointSet(
             vertices=rows[:, xyz],
-            point_data=_properties(names, rows, xyz, meta),
+            point_data=_properties(names, rows, xyz, meta, table),
             name=meta.get("name", path.stem),
             kind=meta.get("kind"),
         )
         crs = CRS.model_validate(meta["crs"]) if meta.get("crs") else None
+        return Scene(entities=[points], crs=crs, name=meta.get("scene", ""))
+    except FormatError:
+        raise
     except (GeobrepError, ValueError, TypeError, AttributeError) as exc:
         where = "the '# geobrep:' line" if meta else "the table"
         raise FormatError(f"{where} does not describe valid points: {exc}", path) from None
-    return Scene(entities=[points], crs=crs, name=meta.get("scene", ""))
 
 
 def _text_block(block: NDArray[np.float64], delimiter: str) -> bytes:
@@ -180,6 +253,13 @@ def _text_block(block: NDArray[np.float64], delimiter: str) -> bytes:
         return body if delimiter == "," else body.replace(b",", delimiter.encode())
     rows = (delimiter.join(repr(v) for v in row) for row in block.tolist())
     return "\n".join(rows).encode()
+
+
+def _json_float(value: float | None) -> float | str | None:
+    """A no-data value as JSON: NaN and infinities as the strings Property reads back."""
+    if value is None or np.isfinite(value):
+        return value
+    return "NaN" if np.isnan(value) else ("Infinity" if value > 0 else "-Infinity")
 
 
 def _merged(scene: Scene) -> PointSet:
@@ -210,8 +290,15 @@ def write_points_table(scene: Scene, path: Path, *, delimiter: str, metadata: bo
         header += (
             [name] if values.shape[1] == 1 else [f"{name}[{k}]" for k in range(values.shape[1])]
         )
+        if misfit_rows(values, np.float64).any():
+            raise FormatError(
+                f"property {name!r} holds integers beyond 2**53, which a text column of "
+                "floats cannot hold exactly",
+                path,
+            )
         columns.append(values.astype(np.float64))
-        info = {"unit": prop.unit, "no_data_value": prop.no_data_value, "dtype": str(prop.dtype)}
+        info = {"unit": prop.unit, "no_data_value": _json_float(prop.no_data_value)}
+        info["dtype"] = str(prop.dtype)
         described[name] = {k: v for k, v in info.items() if v is not None and v != "float64"}
     block = np.concatenate(columns, axis=1)
     with path.open("wb") as handle:
@@ -221,6 +308,10 @@ def write_points_table(scene: Scene, path: Path, *, delimiter: str, metadata: bo
                 meta["crs"] = scene.crs.model_dump(mode="json", exclude_defaults=True)
             meta["properties"] = {k: v for k, v in described.items() if v}
             compact = {k: v for k, v in meta.items() if v or k == "name"}
-            handle.write(f"{METADATA_PREFIX} {json.dumps(compact)}\n".encode())
+            try:
+                text = json.dumps(compact, allow_nan=False)
+            except ValueError as exc:
+                raise FormatError(f"the metadata cannot be written as JSON: {exc}", path) from None
+            handle.write(f"{METADATA_PREFIX} {text}\n".encode())
         handle.write(delimiter.join(header).encode() + b"\n")
         handle.write(_text_block(block, delimiter) + b"\n")

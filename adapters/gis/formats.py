@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 from pydantic import ConfigDict
 
 from geobrep.adapters._file_format import full_capabilities
+from geobrep.adapters.casting import misfit_rows
 from geobrep.errors import FormatError, import_optional
 from geobrep.gis.feature_tables import (
     RESERVED_COLUMNS,
@@ -205,7 +206,7 @@ def _layer_columns(
             finite = np.isfinite(values)
             if not finite.any():
                 continue
-            if name in integer and finite.all():
+            if name in integer and finite.all() and not misfit_rows(values, np.int64).any():
                 values = values.astype(np.int64)
         result[name] = values
     return result
@@ -213,6 +214,13 @@ def _layer_columns(
 
 def read_gis(path: Path, options: GisOptions, driver: str) -> Scene:
     """Read every layer (or ``options.layer``) of a GIS vector file into a scene."""
+    try:
+        return _read_gis(path, options, driver)
+    except UnicodeDecodeError as exc:  # GDAL hands on field names or values that are not UTF-8
+        raise FormatError(f"not a readable {driver} file: text is not UTF-8 ({exc})", path) from exc
+
+
+def _read_gis(path: Path, options: GisOptions, driver: str) -> Scene:
     pyogrio = _pyogrio()
     try:
         listed = pyogrio.list_layers(path)

@@ -40,7 +40,9 @@ from geobrep.adapters.meshio.header import (
     embed_legacy_header,
     embed_vtu_header,
     read_legacy_header,
+    unreadable_field_type,
 )
+from geobrep.adapters.meshio.vtu_sizes import check_vtu_sizes
 from geobrep.errors import FormatError, MissingDependencyError
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry, NoOptions
@@ -99,6 +101,7 @@ class StlOptions(BaseModel):
 
 
 def _read_vtu(path: Path) -> Scene:
+    check_vtu_sizes(path)
     mesh = read_mesh(path, "vtu")
     return layout_to_scene(layout_from_mesh(mesh, path), path)
 
@@ -136,7 +139,15 @@ def _pyvista_available() -> bool:
 
 
 def _read_through_pyvista(path: Path) -> Scene:
-    """Legacy POLYDATA and structured grids: meshio cannot read them, VTK can."""
+    """Legacy POLYDATA and structured grids: meshio cannot read them, VTK can (unless they
+    hold what crashes VTK's reader: then a FormatError)."""
+    unknown = unreadable_field_type(path)
+    if unknown is not None:
+        raise FormatError(
+            f"a FIELD array has type {unknown!r}, which VTK's legacy reader does not know "
+            "(it would crash on it)",
+            path,
+        )
     try:
         from geobrep.adapters.pyvista import read_vtk_dataset
     except ImportError as exc:  # pragma: no cover - same distribution

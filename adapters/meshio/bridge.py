@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.adapters.casting import cast_exactly
 from geobrep.adapters.cell_layout import (
     HEADER_ARRAY,
     CellLayout,
@@ -64,7 +65,8 @@ def layout_from_mesh(mesh: Any, path: Path | None = None) -> CellLayout:
         known = block.type in _KNOWN_CELLS
         keep.append(known)
         if known:
-            blocks.append((block.type, np.asarray(block.data, dtype=np.int64)))
+            what = f"{block.type} connectivity"
+            blocks.append((block.type, cast_exactly(np.asarray(block.data), np.int64, what, path)))
     unknown = sorted({b.type for b, k in zip(mesh.cells, keep, strict=True) if not k})
     if unknown:
         raise FormatError(f"cell types geobrep has no entity for: {', '.join(unknown)}", path)

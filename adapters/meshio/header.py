@@ -9,6 +9,7 @@ the tail is rewritten); :func:`embed_legacy_header` adds a ``FIELD FieldData`` s
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 from typing import Any
@@ -18,7 +19,12 @@ import numpy as np
 from geobrep.adapters.cell_layout import HEADER_ARRAY, decode_header, encode_header
 from geobrep.errors import FormatError
 
-__all__ = ["embed_legacy_header", "embed_vtu_header", "read_legacy_header"]
+__all__ = [
+    "embed_legacy_header",
+    "embed_vtu_header",
+    "read_legacy_header",
+    "unreadable_field_type",
+]
 
 _TAIL = 4096
 _LEGACY_HEAD = 1 << 22
@@ -86,7 +92,39 @@ def read_legacy_header(path: Path) -> dict[str, Any] | None:
         raw = np.frombuffer(head[start : start + count], dtype=np.uint8)
     else:
         stop = head.find(b"\n", start)
-        raw = np.array(head[start:stop].split(), dtype=np.uint8)
+        try:
+            raw = np.array(head[start:stop].split(), dtype=np.uint8)
+        except (ValueError, OverflowError):  # not bytes: not a header geobrep wrote
+            return None
     if raw.size != count:
         return None
     return decode_header(raw)
+
+
+#: The array types VTK's legacy reader knows (lower case, as it compares them).
+VTK_LEGACY_TYPES = frozenset(
+    {
+        "bit", "char", "signed_char", "unsigned_char", "short", "unsigned_short", "int",
+        "unsigned_int", "long", "unsigned_long", "float", "double", "vtkidtype", "vtktypeint64",
+        "vtktypeuint64", "string", "utf8_string", "variant",
+    }
+)  # fmt: skip
+_FIELD_ARRAY = re.compile(rb"(?m)^[ \t]*\S+[ \t]+\d+[ \t]+\d+[ \t]+([A-Za-z_]\w*)[ \t]*\r?$")
+_NOT_TYPES = frozenset({"nan", "inf", "infinity"})
+
+
+def unreadable_field_type(path: Path) -> str | None:
+    """A FIELD array type in the legacy VTK file at ``path`` that VTK's reader does not know.
+
+    VTK's legacy reader crashes the process (a segmentation fault) on a dataset FIELD array of
+    an unknown type, such as the ``vtktypeuint8`` meshio's 5.1 writer uses: such a file must not
+    reach it. Lines that look like an array declaration (``name components tuples type``) are
+    checked; a binary block that happens to look like one is refused too (rare, and safe).
+    """
+    with path.open("rb") as stream:
+        data = stream.read()
+    for match in _FIELD_ARRAY.finditer(data):
+        kind = match.group(1).decode("latin-1").lower()
+        if kind not in VTK_LEGACY_TYPES and kind not in _NOT_TYPES:
+            return match.group(1).decode("latin-1")
+    return None

@@ -18,13 +18,18 @@ from typing import Any, Final
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.adapters import strict_json
+from geobrep.adapters.casting import cast_exactly
 from geobrep.adapters.cell_layout import (
     ENTITY_ARRAY,
     CellLayout,
+    check_header,
     header_applies,
     layout_to_scene,
+    located,
     scene_to_layout,
 )
+from geobrep.adapters.ply.sizes import check_element_sizes
 from geobrep.errors import FormatError, import_optional
 from geobrep.model.entities import PointSet, PolyLine, Surface
 from geobrep.model.properties import PropertyMap
@@ -161,12 +166,10 @@ def write_ply(scene: Scene, path: Path, binary: bool = True) -> None:
 
 
 def _header_of(ply: Any) -> dict[str, Any] | None:
-    import json
-
     for comment in ply.comments:
         if comment.startswith(HEADER_COMMENT):
             try:
-                header = json.loads(comment[len(HEADER_COMMENT) :])
+                header = strict_json.loads(comment[len(HEADER_COMMENT) :])
             except ValueError:
                 return None
             return header if isinstance(header, dict) else None
@@ -205,10 +208,16 @@ def _faces_of(element: Any, path: Path) -> tuple[NDArray[np.int64], NDArray[np.i
     if name is None:
         raise FormatError("PLY face element has no vertex_indices property", path)
     column = data[name]
+    what = f"face {name}"
     if column.dtype.kind != "O":
-        return np.asarray(column, dtype=np.int64).reshape(len(data), -1), None
+        indices = cast_exactly(column, np.int64, what, path)
+        return indices.reshape(len(data), -1) if len(data) else np.zeros((0, 3), np.int64), None
     lengths = np.fromiter((len(f) for f in column), dtype=np.int64, count=len(column))
-    flat = np.concatenate(list(column)).astype(np.int64) if len(column) else np.zeros(0, np.int64)
+    flat = (
+        cast_exactly(np.concatenate(list(column)), np.int64, what, path)
+        if len(column)
+        else np.zeros(0, np.int64)
+    )
     if len(lengths) and (lengths == lengths[0]).all() and lengths[0] in (3, 4):
         return flat.reshape(len(lengths), int(lengths[0])), None
     # polygons of several sizes: fan-triangulate every face
@@ -223,23 +232,52 @@ def _faces_of(element: Any, path: Path) -> tuple[NDArray[np.int64], NDArray[np.i
 
 
 def read_ply(path: Path) -> Scene:
-    """Read a PLY file (binary or ASCII); exactly the scene geobrep wrote, when it did."""
+    """Read a PLY file (binary or ASCII); exactly the scene geobrep wrote, when it did.
+
+    The element counts of the header are checked against the bytes the file holds (and the
+    read budget, :mod:`geobrep.adapters.limits`) before plyfile allocates anything.
+    """
     plyfile = _plyfile()
+    check_element_sizes(path)
     peeked = _peek_header(path)
     width = peeked.get(FACE_WIDTH_KEY) if peeked else None
-    known = {"face": {"vertex_indices": width}} if isinstance(width, int) else {}
+    known = {"face": {"vertex_indices": width}} if isinstance(width, int) and width > 0 else {}
     try:
         ply = plyfile.PlyData.read(str(path), known_list_len=known)
     except Exception as exc:
         raise FormatError(f"not a readable PLY file: {type(exc).__name__}: {exc}", path) from exc
+    elements = _elements_of(ply, path)
+    header = _header_of(ply)
+    ids = {**elements.face_data, **elements.edge_data}
+    with located(path):  # an entity refusing what the file holds says which file
+        if header is not None and (header_applies(header, ids) or elements.faces is None):
+            check_header(header, len(elements.points), path)
+            return _from_header(path, header, elements)
+        return _foreign(path, elements)
+
+
+def _scalar_column(element: Any, name: str, path: Path) -> NDArray[Any]:
+    """A scalar property of a PLY element as numbers; a list or missing property is an error."""
+    data = element.data
+    if name not in (data.dtype.names or ()):
+        raise FormatError(f"PLY {element.name} element has no {name!r} property", path)
+    column = data[name]
+    if column.dtype.kind not in "biuf":
+        raise FormatError(
+            f"PLY {element.name} property {name!r} must be a number, not a list", path
+        )
+    return np.asarray(column)
+
+
+def _elements_of(ply: Any, path: Path) -> _Elements:
+    """The vertices, faces and edges of a parsed PLY file, with their properties."""
     names = [element.name for element in ply.elements]
     if "vertex" not in names:
         raise FormatError("PLY file has no vertex element", path)
     vertex = ply["vertex"]
-    fields = vertex.data.dtype.names or ()
-    if not all(axis in fields for axis in "xyz"):
-        raise FormatError("PLY vertex element lacks x, y or z", path)
-    points = np.column_stack([np.asarray(vertex.data[a], dtype=np.float64) for a in "xyz"])
+    points = np.column_stack(
+        [_scalar_column(vertex, a, path).astype(np.float64) for a in "xyz"]
+    ).reshape(-1, 3)
     point_data = _gather(vertex, ("x", "y", "z"))
     faces, face_owner = _faces_of(ply["face"], path) if "face" in names else (None, None)
     face_data = _gather(ply["face"], _INDEX_NAMES) if "face" in names else {}
@@ -248,21 +286,18 @@ def read_ply(path: Path) -> Scene:
     edge_data: dict[str, NDArray[Any]] = {}
     edges = None
     if "edge" in names:
-        edge_data = _gather(ply["edge"], ("vertex1", "vertex2"))
-        edge = ply["edge"].data
-        edges = np.column_stack([np.asarray(edge["vertex1"]), np.asarray(edge["vertex2"])])
-    header = _header_of(ply)
-    ids = {**face_data, **edge_data}
-    elements = _Elements(points, point_data, faces, face_data, edges, edge_data)
-    if header is not None and (header_applies(header, ids) or faces is None):
-        return _from_header(path, header, elements)
-    return _foreign(path, elements)
+        edge = ply["edge"]
+        edge_data = _gather(edge, ("vertex1", "vertex2"))
+        ends = [
+            cast_exactly(_scalar_column(edge, end, path), np.int64, f"edge {end}", path)
+            for end in ("vertex1", "vertex2")
+        ]
+        edges = np.column_stack(ends).reshape(-1, 2)
+    return _Elements(points, point_data, faces, face_data, edges, edge_data)
 
 
 def _peek_header(path: Path) -> dict[str, Any] | None:
     """geobrep's header comment, read from the PLY header text only."""
-    import json
-
     with path.open("rb") as stream:
         head = stream.read(1 << 20)
     end = head.find(b"end_header")
@@ -271,7 +306,7 @@ def _peek_header(path: Path) -> dict[str, Any] | None:
     for line in head[:end].decode("latin-1").splitlines():
         if line.startswith("comment " + HEADER_COMMENT):
             try:
-                header = json.loads(line[len("comment " + HEADER_COMMENT) :])
+                header = strict_json.loads(line[len("comment " + HEADER_COMMENT) :])
             except ValueError:
                 return None
             return header if isinstance(header, dict) else None
@@ -299,7 +334,7 @@ def _from_header(path: Path, header: dict[str, Any], elements: _Elements) -> Sce
         blocks.append(("triangle" if faces.shape[1] == 3 else "quad", faces))
         pieces.append(_regroup(elements.face_data))
     if edges is not None:
-        blocks.append(("line", edges.astype(np.int64)))
+        blocks.append(("line", edges))
         pieces.append(_regroup(elements.edge_data))
     point_sets = [r for r in header.get("entities", []) if r.get("type") == "PointSet"]
     for record in point_sets:
@@ -353,7 +388,7 @@ def _foreign(path: Path, elements: _Elements) -> Scene:
         entities.append(
             PolyLine(
                 vertices=points,
-                indices=edges.ravel().astype(np.int64),
+                indices=edges.ravel(),
                 part_offsets=np.arange(0, 2 * len(edges) + 1, 2, dtype=np.int64),
                 closed=np.zeros(len(edges), dtype=bool),
                 cell_data=PropertyMap(edge_data),

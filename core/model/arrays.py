@@ -96,8 +96,10 @@ def _from_json(value: dict[str, Any], info: ValidationInfo) -> NDArray[Any]:
     try:
         dtype = np.dtype(value["dtype"])
         shape = tuple(int(s) for s in value["shape"])
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise ValueError(f"malformed array record: {exc}") from None
+    if dtype.kind not in "biuf" or dtype.subdtype is not None:
+        raise ValueError(f"array record dtype {value['dtype']!r} is not a number type")
     if "file" in value:
         reader = (info.context or {}).get(ARRAY_READER) or _ACTIVE_READER.get()
         if reader is None:

@@ -66,7 +66,13 @@ def _assign_ids(entities: Sequence[Any]) -> list[Any]:
     """Give every entity without an id the next free one, in order."""
     used: set[int] = set()
     for item in entities:
-        ident = item.id if isinstance(item, Entity) else (item or {}).get("id")
+        ident = (
+            item.id
+            if isinstance(item, Entity)
+            else item.get("id")
+            if isinstance(item, dict)
+            else None
+        )
         if isinstance(ident, int):
             used.add(ident)
     next_id = max(used, default=-1) + 1
