@@ -22,7 +22,13 @@ from numpy.typing import NDArray
 from geobrep.adapters.gocad.objects import gocad_section
 from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.adapters.gocad.parser import GocadObject
-from geobrep.adapters.gocad.records import Diagnostics, Model3dHeader, ModelList, TFaceEntry
+from geobrep.adapters.gocad.records import (
+    Diagnostics,
+    Model3dHeader,
+    ModelList,
+    RegionEntry,
+    TFaceEntry,
+)
 from geobrep.geometry.bbox import column_extremes
 from geobrep.model.arcs import corners_and_arcs
 from geobrep.model.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
@@ -116,8 +122,17 @@ def _diagonal(surfaces: Sequence[Surface]) -> float:
     points = [s.vertices for s in surfaces if s.n_vertices]
     if not points:
         return 1.0
-    low, high = column_extremes(np.concatenate(points))
-    return float(np.linalg.norm(high - low))
+    return _box_diagonal(np.concatenate(points))
+
+
+def _box_diagonal(points: NDArray[np.float64]) -> float:
+    """The bounding-box diagonal of ``points``, finite even when coordinates near the float64
+    limit (``1e308``) make it overflow (it is then the largest float, so tolerances derived
+    from it stay finite)."""
+    low, high = column_extremes(points)
+    with np.errstate(over="ignore", invalid="ignore"):
+        diagonal = float(np.hypot.reduce(high - low))
+    return diagonal if np.isfinite(diagonal) else float(np.finfo(np.float64).max)
 
 
 @dataclass
@@ -206,6 +221,37 @@ class _TFaceMatcher:
         )
 
 
+def _region_sides(
+    region: RegionEntry, matched: _TFaceMatcher, patch_ids: set[int], builder: Diagnostics
+) -> tuple[PatchSide, ...]:
+    """A REGION's signed TFACE ids as patch sides (turned with their flipped TFACEs), each
+    once, in the order first listed: one warning for all the ids a REGION repeats."""
+    values = np.asarray(region.items, dtype=np.int64)
+    unique, first = np.unique(values, return_index=True)
+    order = np.sort(first)
+    sides: list[PatchSide] = []
+    for value in values[order].tolist():
+        tface = abs(value)
+        if tface not in patch_ids:
+            raise builder.error(
+                f"REGION {region.name!r} refers to TFACE {tface}, which is not defined",
+                region.line,
+            )
+        side = 1 if value > 0 else -1
+        if matched.flipped.get(tface):
+            side = -side
+        sides.append(PatchSide(tface, side))  # type: ignore[arg-type]
+    if unique.shape[0] < values.shape[0]:
+        again = np.ones(values.shape[0], dtype=bool)
+        again[first] = False
+        builder.warn(
+            f"REGION {region.name!r} lists {values.shape[0] - unique.shape[0]} side(s) again "
+            f"(the first {int(values[np.argmax(again)]):+d}); each is kept once",
+            region.line,
+        )
+    return tuple(sides)
+
+
 def _region_blocks(
     header: Model3dHeader, matched: _TFaceMatcher, first_id: int, builder: Diagnostics
 ) -> tuple[list[Entity], dict[int, int]]:
@@ -226,22 +272,7 @@ def _region_blocks(
                 "it is renumbered when written",
                 region.line,
             )
-        sides: list[PatchSide] = []
-        for value in region.items:
-            tface = abs(value)
-            if tface not in patch_ids:
-                raise builder.error(
-                    f"REGION {region.name!r} refers to TFACE {tface}, which is not defined",
-                    region.line,
-                )
-            side = 1 if value > 0 else -1
-            if matched.flipped.get(tface):
-                side = -side
-            pair = PatchSide(tface, side)  # type: ignore[arg-type]
-            if pair in sides:
-                builder.warn(f"REGION {region.name!r} lists {value:+d} twice", region.line)
-                continue
-            sides.append(pair)
+        sides = _region_sides(region, matched, patch_ids, builder)
         block_id = first_id + len(blocks)
         region_block[region.id] = block_id
         universe = region.name.strip().lower() == "universe"
@@ -250,7 +281,7 @@ def _region_blocks(
                 id=block_id,
                 name=region.name,
                 kind=UNIVERSE_KIND if universe else "unit",
-                sides=tuple(sides),
+                sides=sides,
                 unit_name=None if universe else layer_of.get(region.id),
                 metadata={"gocad": {"region_id": region.id}},
             )
@@ -420,6 +451,5 @@ def border_topology(
         )
     ]
     points = np.concatenate([s.vertices for s in surfaces if s.n_vertices] or [np.zeros((1, 3))])
-    low, high = column_extremes(points)
-    diagonal = float(np.linalg.norm(high - low))
+    diagonal = _box_diagonal(points)
     return _rebuilt_topology(surfaces, patches, options.merge_tolerance_for(diagonal), warn)

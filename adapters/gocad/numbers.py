@@ -14,7 +14,15 @@ from numpy.typing import NDArray
 
 from geobrep.adapters.gocad.lexer import ORJSON
 
-__all__ = ["format_float", "format_rows", "parse_float", "parse_int", "row_pieces"]
+__all__ = [
+    "INT_LIMIT",
+    "format_float",
+    "format_rows",
+    "parse_float",
+    "parse_int",
+    "row_pieces",
+    "shown",
+]
 
 _SPECIAL = {
     "inf": math.inf,
@@ -35,6 +43,17 @@ _SPECIAL = {
 }
 
 
+def shown(token: str, limit: int = 40) -> str:
+    """``repr`` of a token for a message, cut to about ``limit`` characters.
+
+    >>> shown("1" * 100)
+    "'1111111111111111111111111111111111111111…' (100 characters)"
+    """
+    if len(token) <= limit:
+        return repr(token)
+    return f"{token[:limit] + '…'!r} ({len(token)} characters)"
+
+
 def parse_float(token: str) -> float:
     """A float from a token, accepting ``inf``, ``1.#INF`` and friends; ValueError if not one.
 
@@ -46,16 +65,31 @@ def parse_float(token: str) -> float:
     except ValueError:
         special = _SPECIAL.get(token.lower())
         if special is None:
-            raise ValueError(f"{token!r} is not a number") from None
+            raise ValueError(f"{shown(token)} is not a number") from None
         return special
 
 
+#: Ids are stored as int64 and subtracted from one another (id lookups): magnitudes above
+#: 2**62 are refused where they are read, so no id or difference of ids wraps around.
+INT_LIMIT = 2**62
+
+
 def parse_int(token: str) -> int:
-    """An integer id; ValueError for anything else (``"1.5"``, ``"x"``)."""
+    """An integer id; ValueError for anything else (``"1.5"``, ``"x"``, ``"0x10"``) and for an
+    integer of magnitude above :data:`INT_LIMIT` (``2**62``).
+
+    >>> parse_int("18446744073709551616")
+    Traceback (most recent call last):
+    ...
+    ValueError: '18446744073709551616' is too large for an id (at most 2**62 in magnitude)
+    """
     try:
-        return int(token)
+        value = int(token)
     except ValueError:
-        raise ValueError(f"{token!r} is not an integer") from None
+        raise ValueError(f"{shown(token)} is not an integer") from None
+    if not -INT_LIMIT <= value <= INT_LIMIT:
+        raise ValueError(f"{shown(token)} is too large for an id (at most 2**62 in magnitude)")
+    return value
 
 
 def format_float(value: float) -> str:

@@ -32,7 +32,7 @@ from geobrep.adapters.gocad.lexer import (
     scan,
     split_tokens,
 )
-from geobrep.adapters.gocad.numbers import parse_float, parse_int
+from geobrep.adapters.gocad.numbers import INT_LIMIT, parse_float, parse_int
 from geobrep.adapters.gocad.records import (
     Border,
     BStone,
@@ -411,6 +411,12 @@ class _Parser:
                         f"{keyword} needs 3 entries, found {len(parts)}; ignored", item.number
                     )
                     continue
+                empty = [i for i, part in enumerate(parts, start=1) if not part.strip()]
+                if empty:
+                    raise self.error(
+                        f"{keyword} entry {empty[0]} is empty (axis names and units need text)",
+                        item.number,
+                    )
                 crs[keyword] = parts
             elif keyword == "ZPOSITIVE":
                 direction = value.split()[0].capitalize() if value.split() else ""
@@ -479,7 +485,7 @@ class _Parser:
                 break
             if obj.type == "Model3d":
                 if not self._common(obj, item):
-                    self._model3d_line(obj, item, header)
+                    self._model3d_entry(obj, item, keyword, header)
                 continue
             if vertices is None:
                 # Header part: the property header is only complete at the first data line.
@@ -857,6 +863,17 @@ class _Parser:
         return solid.surfaces[-1][1][-1]
 
     # -- Model3d header -------------------------------------------------------------------------
+    def _model3d_entry(
+        self, obj: GocadObject, item: Line, keyword: str, header: _Model3dDraft
+    ) -> None:
+        """:meth:`_model3d_line`, with a bad number named with its keyword and line."""
+        try:
+            self._model3d_line(obj, item, header)
+        except ValueError as exc:
+            if isinstance(exc, FormatError):
+                raise
+            raise self.error(f"{keyword}: {exc}", item.number) from None
+
     def _model3d_line(self, obj: GocadObject, item: Line, header: _Model3dDraft) -> None:
         keyword = _keyword(item.text)
         text = item.text
@@ -913,15 +930,20 @@ class _Parser:
         current = header.current
         if current is None or current.closed:
             return False
-        for token in numbers:
-            try:
-                value = parse_int(token)
-            except ValueError as exc:
-                raise self.error(f"{exc} in the list of {current.name!r}", item.number) from None
-            if value == 0:
-                current.closed = True
-                break
-            current.items.append(value)
+        values = _list_ids(numbers)
+        if values is None:  # some token is no id: name the first
+            for token in numbers:
+                try:
+                    parse_int(token)
+                except ValueError as exc:
+                    raise self.error(
+                        f"{exc} in the list of {current.name!r}", item.number
+                    ) from None
+        assert values is not None
+        if 0 in values:
+            values = values[: values.index(0)]
+            current.closed = True
+        current.items.extend(values)
         return True
 
     def _finish_model3d(self, header: _Model3dDraft) -> Model3dHeader:
@@ -1005,6 +1027,18 @@ _NUMBERS_ONLY = re.compile(r"[-+0-9.eE\s]+")
 _CTETRA_ENTRY = re.compile(r'(?:[^\s"]+|"[^"]*")+')
 
 
+def _list_ids(tokens: list[str]) -> list[int] | None:
+    """The ids of a Model3d list line as :func:`parse_int` reads them, in one C-level pass
+    (a line may hold a million); None when a token is not one."""
+    try:
+        values = list(map(int, tokens))
+    except ValueError:
+        return None
+    if values and not -INT_LIMIT <= min(values) <= max(values) <= INT_LIMIT:
+        return None
+    return values
+
+
 def _unquote(text: str) -> str:
     if len(text) >= 2 and text[0] == '"' and text.endswith('"'):
         return text[1:-1]
@@ -1012,11 +1046,14 @@ def _unquote(text: str) -> str:
 
 
 def _strip_flags(tokens: list[str]) -> tuple[int, list[str]]:
-    flag = 0
-    while tokens and tokens[-1].upper() in FLAG_NAMES:
-        flag = FLAG_NAMES[tokens[-1].upper()]
-        tokens = tokens[:-1]
-    return flag, tokens
+    """The trailing flag words (``CNXYZ``, ...) off ``tokens``: the first one's flag, the rest
+    (one pass, one copy however many flags a line repeats)."""
+    end = len(tokens)
+    while end and tokens[end - 1].upper() in FLAG_NAMES:
+        end -= 1
+    if end == len(tokens):
+        return 0, tokens
+    return FLAG_NAMES[tokens[end].upper()], tokens[:end]
 
 
 def parse_source(source: Source, skipped: list[str] | None = None) -> list[GocadObject]:

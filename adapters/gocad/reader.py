@@ -339,6 +339,7 @@ class _Builder:
         names = tuple(name or str(i) for i, name in enumerate(obj.part_names))
         if obj.type == "TSurf":
             self._warn_empty_tfaces(obj, parts)
+            self._warn_bad_triangles(obj, xyz, index, lines)
             self._hints(obj, lookup, fields)
             self._warn_inner_borders(obj, index, parts, fields)
             self.entities.append(
@@ -374,6 +375,34 @@ class _Builder:
                 "which is not written back)",
                 obj.part_lines[label],
             )
+
+    def _warn_bad_triangles(
+        self,
+        obj: GocadObject,
+        xyz: NDArray[np.float64],
+        faces: NDArray[np.int64],
+        lines: NDArray[np.int64],
+    ) -> None:
+        """One warning per TSurf with duplicated triangles (the three vertices of an earlier
+        TRGL, in any order) or zero-area ones (a repeated vertex, or three collinear points);
+        the triangles are kept as read."""
+        if faces.shape[0] == 0:
+            return
+        duplicated = np.ones(faces.shape[0], dtype=bool)
+        duplicated[np.unique(np.sort(faces, axis=1), axis=0, return_index=True)[1]] = False
+        corners = xyz[faces]
+        with np.errstate(over="ignore", invalid="ignore"):
+            normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        flat = ~(normals != 0).any(axis=1)  # NaN from overflow is not "zero area"
+        bad = duplicated | flat
+        if not bad.any():
+            return
+        self.warn(
+            f"TSurf {obj.name!r}: {int(duplicated.sum())} duplicated triangle(s) (the same "
+            f"three vertices as an earlier TRGL) and {int(flat.sum())} zero-area triangle(s) "
+            "(the first on this line); kept as read",
+            int(lines[int(np.argmax(bad))]),
+        )
 
     def _warn_inner_borders(
         self,

@@ -192,8 +192,8 @@ class IdLookup:
     def find(self, ids: NDArray[Any]) -> tuple[IntArray, NDArray[np.bool_]]:
         """Indices of ``ids`` and whether each was found."""
         flat = np.asarray(ids, dtype=np.int64).reshape(-1)
-        if self.sorted_ids.size == 0:
-            return np.zeros(flat.shape, dtype=np.int64), np.zeros(flat.shape, dtype=bool)
+        if self.sorted_ids.size == 0:  # no vertices: nothing is found (shaped like ``ids``)
+            return np.zeros(np.shape(ids), dtype=np.int64), np.zeros(np.shape(ids), dtype=bool)
         if self.consecutive:
             index = flat - self.first
             found = (index >= 0) & (index < self.sorted_ids.shape[0])
