@@ -235,7 +235,33 @@ def _gmsh_write(scene: Scene, path: Path, options: BaseModel) -> None:
     write_mesh(mesh, path, "gmsh22", binary=True)
 
 
+#: The most string or real tags a Gmsh data section may declare (real files have one or two).
+GMSH_MAX_TAGS = 1024
+_GMSH_DATA = frozenset({b"$NodeData", b"$ElementData", b"$ElementNodeData"})
+
+
+def check_gmsh_tags(path: Path) -> None:
+    """Refuse a Gmsh data section declaring more tags than :data:`GMSH_MAX_TAGS`: meshio reads
+    that many lines past the end of the file (4294967296 tags: a hang)."""
+    with path.open("rb") as stream:
+        lines = stream.read().split(b"\n")
+    for number, line in enumerate(lines):
+        if line.strip() not in _GMSH_DATA:
+            continue
+        at = number + 1
+        for kind in ("string", "real"):
+            try:
+                count = int(lines[at])
+            except (IndexError, ValueError):
+                break  # meshio says what is wrong
+            if not 0 <= count <= GMSH_MAX_TAGS:
+                section = line.strip().decode()
+                raise FormatError(f"{section} declares {count} {kind} tags", path, at + 1)
+            at += 1 + count
+
+
 def _read_gmsh(path: Path) -> Scene:
+    check_gmsh_tags(path)
     mesh = read_mesh(path, "gmsh")
     physical = mesh.cell_data.pop("gmsh:physical", None)
     mesh.cell_data.pop("gmsh:geometrical", None)

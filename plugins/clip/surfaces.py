@@ -11,6 +11,7 @@ sides.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,6 +26,7 @@ from geobrep.plugins.clip.loops import order_paths
 from geobrep.plugins.clip.options import SurfaceClipOptions, tolerance_of
 from geobrep.plugins.clip.sides import interpolate_properties
 from geobrep.plugins.clip.triangles import HalfMesh, InPlaneRule, TriangleCut, cut_triangles
+from geobrep.plugins.clip.welding import UnweldedSurfaceWarning, closed_once_welded
 
 __all__ = ["SurfaceCut", "clip_surface", "section_surface", "surface_cut"]
 
@@ -109,20 +111,46 @@ def clip_surface(
             parts[side] = surface if own else None
         else:
             parts[side] = _half(state, side, rule, capping)
+    if len(parts) and counts[3] and not capping:
+        _warn_if_unwelded(surface, options, context)
     return pack_halves(keep, parts)
 
 
 def _caps_wanted(surface: Surface, options: SurfaceClipOptions, context: ClipContext) -> bool:
     if options.caps != "auto":
         return options.caps == "always"
+    if _bounds_blocks(surface, context):
+        return False  # a boundary of blocks: the Block clipper caps the blocks
+    return surface.is_closed
+
+
+def _bounds_blocks(surface: Surface, context: ClipContext) -> bool:
     scene = context.scene
-    if (
+    return bool(
         scene is not None
         and scene.blocks
         and any(patch.surface == surface.id for patch in scene.patches)
-    ):
-        return False  # a boundary of blocks: the Block clipper caps the blocks
-    return surface.is_closed
+    )
+
+
+def _warn_if_unwelded(surface: Surface, options: SurfaceClipOptions, context: ClipContext) -> None:
+    """Warn when ``surface``, cut without caps by ``caps="auto"``, would be closed (and so
+    capped) once its seams are welded."""
+    if options.caps != "auto" or surface.is_closed or _bounds_blocks(surface, context):
+        return
+    tolerance = tolerance_of(options, context)
+    welded = closed_once_welded(surface, tolerance)
+    if welded is None:
+        return
+    vertices, faces = welded
+    collapsed = f" and dropping {faces} sliver face(s)" if faces else ""
+    warnings.warn(
+        f"{surface.label} is closed once {vertices} duplicated vertices within {tolerance:g} "
+        f"are welded{collapsed}, but not as given: its halves are not capped. Weld it first "
+        "(geobrep.geometry.mesh.merge_close_vertices) or clip with caps='always'.",
+        UnweldedSurfaceWarning,
+        stacklevel=2,
+    )
 
 
 def _half(state: SurfaceCut, side: int, rule: InPlaneRule, capping: bool) -> Surface | None:
@@ -225,7 +253,10 @@ def section_surface(
         "kind": surface.kind,
         "metadata": {**surface.metadata, "surface": surface.id},
     }
-    if _caps_wanted(surface, options, context):
+    capping = _caps_wanted(surface, options, context)
+    if not capping and state.cut.pieces.shape[0]:
+        _warn_if_unwelded(surface, options, context)
+    if capping:
         half = state.half(-1, "none")
         boundary = open_boundary(half.plane_edges, half.vertices.shape[0])
         polygons = cap_rings(half.vertices, boundary, state.normal, surface.label)
