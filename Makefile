@@ -10,13 +10,14 @@ STAMPS := $(VENV)/.geobrep-stamps
 EXAMPLE_PLUGIN := docs/examples/geobrep-example-plugin
 PIP_QUIET := --quiet --disable-pip-version-check
 
-.PHONY: demo test test-newest test-min lint typecheck pytest bench schemas sysdeps clean help
+.PHONY: demo test test-newest test-min lint typecheck pytest bench fuzz schemas sysdeps clean help
 
 help:
 	@echo "make demo   - run the demo on the built-in sample model (writes demo-output/)"
 	@echo "make test   - ruff + mypy + the whole test suite (newest allowed dependencies)"
 	@echo "make test-min - the suite on the lowest versions pyproject.toml allows (.venv-min)"
 	@echo "make bench  - benchmarks (not part of make test)"
+	@echo "make fuzz   - 25,000 mutated files through every reader (not part of make test)"
 
 $(PY):
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "geobrep needs Python 3.11 or newer: set PYTHON=python3.11 (or newer)")'
@@ -112,6 +113,12 @@ schemas: $(STAMPS)/base
 bench: $(STAMPS)/test
 	$(PY) -m pip install $(PIP_QUIET) -e ".[bench]"
 	$(PY) benchmarks/run_all.py
+
+# The readers' large fuzz run (not part of make test): 25,000 mutated files, each read in a worker
+# process within 10 s and max(256 MB, 20 x its size) of memory; prints the figures per format.
+FUZZ_CASES ?= 25000
+fuzz: $(STAMPS)/test
+	$(PY) benchmarks/fuzz.py --cases $(FUZZ_CASES) --timeout 10
 
 clean:
 	rm -rf build dist *.egg-info .mypy_cache .ruff_cache .pytest_cache demo-output

@@ -40,7 +40,7 @@ from geobrep.adapters.meshio.header import (
     embed_legacy_header,
     embed_vtu_header,
     read_legacy_header,
-    unreadable_field_type,
+    vtk_field_problem,
 )
 from geobrep.adapters.meshio.vtu_sizes import check_vtu_sizes
 from geobrep.errors import FormatError, MissingDependencyError
@@ -141,13 +141,9 @@ def _pyvista_available() -> bool:
 def _read_through_pyvista(path: Path) -> Scene:
     """Legacy POLYDATA and structured grids: meshio cannot read them, VTK can (unless they
     hold what crashes VTK's reader: then a FormatError)."""
-    unknown = unreadable_field_type(path)
-    if unknown is not None:
-        raise FormatError(
-            f"a FIELD array has type {unknown!r}, which VTK's legacy reader does not know "
-            "(it would crash on it)",
-            path,
-        )
+    problem = vtk_field_problem(path)
+    if problem is not None:  # VTK would crash on it: geobrep says what is wrong instead
+        raise FormatError(f"{problem} (VTK's legacy reader cannot read it safely)", path)
     try:
         from geobrep.adapters.pyvista import read_vtk_dataset
     except ImportError as exc:  # pragma: no cover - same distribution
@@ -169,8 +165,21 @@ def _write_legacy(scene: Scene, path: Path, options: LegacyVtkOptions) -> None:
         embed_legacy_header(path, layout.header, options.binary)
 
 
+def check_off_counts(path: Path) -> None:
+    """Refuse an OFF file with no counts line after ``OFF``: meshio would look for it forever."""
+    with path.open("rb") as stream:
+        stream.readline()
+        for line in stream:
+            text = line.strip()
+            if text and not text.startswith(b"#"):
+                return
+    raise FormatError("an OFF file needs a line of vertex, face and edge counts after OFF", path)
+
+
 def _reader(file_format: str) -> Callable[[Path], Scene]:
     def read(path: Path) -> Scene:
+        if file_format == "off":
+            check_off_counts(path)
         return layout_to_scene(layout_from_mesh(read_mesh(path, file_format), path), path)
 
     return read

@@ -23,7 +23,7 @@ __all__ = [
     "embed_legacy_header",
     "embed_vtu_header",
     "read_legacy_header",
-    "unreadable_field_type",
+    "vtk_field_problem",
 ]
 
 _TAIL = 4096
@@ -110,21 +110,34 @@ VTK_LEGACY_TYPES = frozenset(
     }
 )  # fmt: skip
 _FIELD_ARRAY = re.compile(rb"(?m)^[ \t]*\S+[ \t]+\d+[ \t]+\d+[ \t]+([A-Za-z_]\w*)[ \t]*\r?$")
+_FIELD_LINE = re.compile(rb"(?m)^[ \t]*FIELD\b[^\n]*\n?")
+_FIELD_HEAD = re.compile(rb"[ \t]*FIELD[ \t]+\S+[ \t]+\d+[ \t]*\r?\n")
+_DECLARATION = re.compile(rb"[ \t]*\S+[ \t]+\d+[ \t]+\d+[ \t]+([A-Za-z_]\w*)[ \t]*\r?\n")
 _NOT_TYPES = frozenset({"nan", "inf", "infinity"})
 
 
-def unreadable_field_type(path: Path) -> str | None:
-    """A FIELD array type in the legacy VTK file at ``path`` that VTK's reader does not know.
+def vtk_field_problem(path: Path) -> str | None:
+    """What, in the legacy VTK file at ``path``, VTK's reader would crash on; None if nothing.
 
-    VTK's legacy reader crashes the process (a segmentation fault) on a dataset FIELD array of
-    an unknown type, such as the ``vtktypeuint8`` meshio's 5.1 writer uses: such a file must not
-    reach it. Lines that look like an array declaration (``name components tuples type``) are
-    checked; a binary block that happens to look like one is refused too (rare, and safe).
+    VTK's legacy reader crashes the process (a segmentation fault) on FIELD data it cannot
+    parse: an unknown array type (such as the ``vtktypeuint8`` meshio's 5.1 writer uses), a
+    FIELD line without its array count, or a first array declaration that is not
+    ``name components tuples type``. Such a file must not reach it. Lines elsewhere that look
+    like an array declaration are checked too (a binary block that happens to look like one is
+    refused: rare, and safe).
     """
     with path.open("rb") as stream:
         data = stream.read()
+    for match in _FIELD_LINE.finditer(data):
+        head = _FIELD_HEAD.match(data, match.start())
+        if head is None:
+            return f"a FIELD line is not 'FIELD name count': {match.group(0)[:60]!r}"
+        declaration = _DECLARATION.match(data, head.end())
+        if declaration is None:
+            shown = data[head.end() : head.end() + 60]
+            return f"a FIELD array declaration is not 'name components tuples type': {shown!r}"
     for match in _FIELD_ARRAY.finditer(data):
-        kind = match.group(1).decode("latin-1").lower()
-        if kind not in VTK_LEGACY_TYPES and kind not in _NOT_TYPES:
-            return match.group(1).decode("latin-1")
+        kind = match.group(1).decode("latin-1")
+        if kind.lower() not in VTK_LEGACY_TYPES and kind.lower() not in _NOT_TYPES:
+            return f"a FIELD array has type {kind!r}, which VTK's legacy reader does not know"
     return None

@@ -59,14 +59,27 @@ class VtpOptions(BaseModel):
 
 
 def read_vtk_dataset(path: Path, extension: str | None = None) -> Scene:
-    """Any file VTK reads (legacy POLYDATA included), as a scene."""
+    """Any file VTK reads (legacy POLYDATA included), as a scene.
+
+    VTK reports a file it cannot parse as error messages and hands back what it got so far
+    (often nothing): an error VTK reports while reading is a :class:`FormatError`, never an
+    empty or partial scene.
+    """
     pv = import_pyvista(f"reading {path.name}")
+    from pyvista.core.utilities import VtkErrorCatcher
+
+    catcher = VtkErrorCatcher(raise_errors=False, send_to_logging=False)
     try:
-        dataset = pv.read(path, force_ext=extension) if extension else pv.read(path)
+        with catcher:
+            dataset = pv.read(path, force_ext=extension) if extension else pv.read(path)
     except Exception as exc:
         raise FormatError(
             f"VTK could not read this file: {type(exc).__name__}: {exc}", path
         ) from exc
+    errors = [event for event in catcher.events if event.kind == "ERROR"]
+    if errors:
+        said = (errors[0].alert.strip().splitlines() or ["an error"])[0]
+        raise FormatError(f"VTK could not read this file: {said}", path)
     if isinstance(dataset, pv.MultiBlock):
         result = from_pyvista(dataset)
         return result if isinstance(result, Scene) else Scene(entities=[result])
