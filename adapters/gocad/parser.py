@@ -520,6 +520,16 @@ class _Parser:
         """The vertex and cell tables, sized by the (now complete) property headers."""
         obj.point_header.resolve(self.warn)
         obj.cell_header.resolve(self.warn)
+        # A value takes at least two bytes ("0 "): a header declaring more values per element
+        # than the whole file could hold would only make every element a row of padding.
+        room = max(64, len(self.source.data) // 2)
+        for kind, header in (("vertex", obj.point_header), ("cell", obj.cell_header)):
+            if header.n_values > room:
+                raise self.error(
+                    f"{obj.type} {obj.name!r}: the property header declares {header.n_values} "
+                    f"values per {kind}, more than this {len(self.source.data)}-byte file holds",
+                    None,
+                )
         width = _CELL_WIDTH.get(obj.type)
         cells = CellTable(width, obj.cell_header.n_values) if width else None
         return VertexTable(obj.point_header.n_values), cells

@@ -360,3 +360,17 @@ def test_clean_test_files_get_no_triangle_warning() -> None:
             except geobrep.FormatError:
                 continue
         assert not [w for w in caught if "duplicated triangle" in str(w.message)], path
+
+
+def test_a_property_header_declaring_more_values_than_the_file_holds_is_refused(
+    tmp_path: Path,
+) -> None:
+    """120 bytes declaring ESIZES 100000000 took 4.8 GB (a NaN row of 1e8 per vertex)."""
+    path = tmp_path / "bomb.vs"
+    path.write_text(
+        "GOCAD VSet 1\nHEADER {\nname: bomb\n}\nPROPERTIES a\nESIZES 100000000\n"
+        "VRTX 1 0 0 0\nVRTX 2 1 0 0\nEND\n",
+        encoding="utf-8",
+    )
+    with pytest.raises(geobrep.FormatError, match="declares 100000000 values per vertex"):
+        geobrep.read(path)
