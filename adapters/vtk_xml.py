@@ -1,9 +1,14 @@
-"""The compressed arrays of a VTU file, checked before meshio inflates them.
+"""What a VTK XML file (VTU, VTP) declares, checked before meshio or VTK allocates or inflates it.
 
-A VTU file compressed with zlib or lzma stores each binary ``DataArray`` as a header
-``[#blocks, block size, last block size, compressed size of each block]`` and the compressed
-blocks; meshio inflates every block whole, so 5 MB of zlib can become gigabytes.
-:func:`check_vtu_sizes` reads each header, refuses a file whose arrays declare more than the
+:func:`check_xml_counts`: the counts of every ``<Piece>`` and ``<DataArray>``
+(``NumberOfPoints``, ``NumberOfTuples`` x ``NumberOfComponents``, ...) are non-negative integers
+within the read budget (:mod:`geobrep.adapters.limits`); VTK allocates what they say (a VTP
+declaring 400 000 000 points kills the process).
+
+:func:`check_vtu_sizes`: a file compressed with zlib or lzma stores each binary ``DataArray``
+as a header ``[#blocks, block size, last block size, compressed size of each block]`` and the
+compressed blocks; meshio and VTK inflate every block whole, so 5 MB of zlib can become
+gigabytes. It reads each header, refuses a file whose arrays declare more than the
 read budget (:mod:`geobrep.adapters.limits`) in all, and inflates each block in bounded steps
 (keeping nothing) to make sure it holds no more than its header declares: what meshio then
 inflates is bounded by the budget. Inline (``format="binary"``) and appended (base64 or raw)
@@ -25,7 +30,7 @@ import numpy as np
 from geobrep.adapters.limits import check_declared, inflate_bounded
 from geobrep.errors import FormatError
 
-__all__ = ["check_vtu_sizes"]
+__all__ = ["check_vtu_sizes", "check_xml_counts"]
 
 _COMPRESSORS: Final[dict[str, Literal["zlib", "lzma"]]] = {
     "vtkZLibDataCompressor": "zlib",
@@ -167,3 +172,45 @@ def _check_raw_appended(budget: _Budget) -> None:
         name = f"at appended offset {position}"
         used = budget.blocks(bytes(data[position:header_end]), data[header_end:], name)
         position = header_end + used
+
+
+_TAG = re.compile(rb"<(Piece|DataArray)\b([^>]*)>")
+_ATTRIBUTE = re.compile(rb'([\w:]+)\s*=\s*"([^"]*)"')
+#: Bytes at least per declared item: a point (3 doubles), a cell (one offset), a value.
+_ITEM_BYTES: Final = {"NumberOfPoints": 24}
+
+
+def _counts(attributes: dict[bytes, bytes], path: Path) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for key, text in attributes.items():
+        name = key.decode("latin-1")
+        if not name.startswith("NumberOf"):
+            continue
+        try:
+            value = int(text)
+        except ValueError:
+            shown = text.decode("latin-1")[:40]
+            raise FormatError(f"{name}={shown!r} is not a count", path) from None
+        if value < 0:
+            raise FormatError(f"{name}={value} is negative", path)
+        counts[name] = value
+    return counts
+
+
+def check_xml_counts(path: Path) -> None:
+    """Raise :class:`FormatError` when a ``<Piece>`` or ``<DataArray>`` declares a count that
+    is not a non-negative integer, or more data than the read budget allows."""
+    with path.open("rb") as stream:
+        data = stream.read()
+    size = len(data)
+    for tag in _TAG.finditer(data):
+        attributes = dict(_ATTRIBUTE.findall(tag.group(2)))
+        counts = _counts(attributes, path)
+        if tag.group(1) == b"Piece":
+            declared = sum(value * _ITEM_BYTES.get(name, 8) for name, value in counts.items())
+            check_declared(declared, size, "a <Piece>", path)
+        else:
+            name = attributes.get(b"Name", b"?").decode("latin-1")
+            tuples = counts.get("NumberOfTuples", 0)
+            declared = tuples * max(counts.get("NumberOfComponents", 1), 1) * 8
+            check_declared(declared, size, f"DataArray {name!r}", path)

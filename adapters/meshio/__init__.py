@@ -42,7 +42,7 @@ from geobrep.adapters.meshio.header import (
     read_legacy_header,
     vtk_field_problem,
 )
-from geobrep.adapters.meshio.vtu_sizes import check_vtu_sizes
+from geobrep.adapters.vtk_xml import check_vtu_sizes, check_xml_counts
 from geobrep.errors import FormatError, MissingDependencyError
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry, NoOptions
@@ -101,6 +101,7 @@ class StlOptions(BaseModel):
 
 
 def _read_vtu(path: Path) -> Scene:
+    check_xml_counts(path)
     check_vtu_sizes(path)
     mesh = read_mesh(path, "vtu")
     return layout_to_scene(layout_from_mesh(mesh, path), path)

@@ -24,6 +24,7 @@ from geobrep.adapters.pyvista.convert import (
     to_pyvista,
 )
 from geobrep.adapters.pyvista.render import RenderOptions, render_scene
+from geobrep.adapters.vtk_xml import check_vtu_sizes, check_xml_counts
 from geobrep.errors import FormatError
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
@@ -87,6 +88,8 @@ def read_vtk_dataset(path: Path, extension: str | None = None) -> Scene:
 
 
 def _read_vtp(path: Path) -> Scene:
+    check_xml_counts(path)  # VTK allocates what the counts say, and inflates every block
+    check_vtu_sizes(path)
     return read_vtk_dataset(path, ".vtp")
 
 

@@ -289,3 +289,27 @@ def test_legacy_vtk_field_type_vtk_crashes_on_is_refused(tmp_path: Path) -> None
     (probe,) = probe_reads([path], timeout=120)
     assert probe.outcome == "FormatError", probe
     assert "a FIELD array has type 'foo'" in probe.message
+
+
+def test_vtp_counts_beyond_the_budget_are_refused_before_vtk(tmp_path: Path) -> None:
+    """VTK allocates what NumberOfPoints says: 4e8 points killed the process."""
+    path = geobrep.write(geobrep.datasets.faulted_layer_cake(), tmp_path / "cake.vtp")
+    text = path.read_bytes()
+    found = re.search(rb'NumberOfPoints="\d+"', text)
+    assert found is not None
+    huge = tmp_path / "huge.vtp"
+    huge.write_bytes(text.replace(found.group(0), b'NumberOfPoints="400000000"', 1))
+    negative = tmp_path / "negative.vtp"
+    negative.write_bytes(text.replace(found.group(0), b'NumberOfPoints="-1"', 1))
+    probes = probe_reads([huge, negative], timeout=120)
+    assert [p.outcome for p in probes] == ["FormatError", "FormatError"], probes
+    assert "a <Piece> declares 8.9 GiB" in probes[0].message
+    assert "NumberOfPoints=-1 is negative" in probes[1].message
+
+
+def test_truncated_vtp_is_an_error_not_an_empty_scene(tmp_path: Path) -> None:
+    path = geobrep.write(geobrep.datasets.faulted_layer_cake(), tmp_path / "cake.vtp")
+    cut = tmp_path / "cut.vtp"
+    cut.write_bytes(path.read_bytes()[:3000])
+    with pytest.raises(FormatError, match="VTK could not read this file"):
+        geobrep.read(cut)
