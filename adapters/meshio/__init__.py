@@ -250,28 +250,62 @@ GMSH_MAX_TAGS = 1024
 _GMSH_DATA = frozenset({b"$NodeData", b"$ElementData", b"$ElementNodeData"})
 
 
-def check_gmsh_tags(path: Path) -> None:
-    """Refuse a Gmsh data section declaring more tags than :data:`GMSH_MAX_TAGS`: meshio reads
-    that many lines past the end of the file (4294967296 tags: a hang)."""
+def _gmsh_int(lines: list[bytes], at: int) -> int | None:
+    try:
+        return int(lines[at])
+    except (IndexError, ValueError):
+        return None  # meshio says what is wrong
+
+
+def _gmsh_data_counts(lines: list[bytes], number: int, size: int, path: Path) -> None:
+    """The tags of the data section starting at line ``number``: at most :data:`GMSH_MAX_TAGS`
+    string and real tags (meshio reads that many lines, past the end of the file), and no more
+    values than the file's bytes can hold (meshio allocates what the integer tags say)."""
+    section = lines[number].strip().decode()
+    at = number + 1
+    for kind in ("string", "real"):
+        count = _gmsh_int(lines, at)
+        if count is None:
+            return
+        if not 0 <= count <= GMSH_MAX_TAGS:
+            raise FormatError(f"{section} declares {count} {kind} tags", path, at + 1)
+        at += 1 + count
+    count = _gmsh_int(lines, at)
+    if count is None or not 3 <= count <= GMSH_MAX_TAGS:
+        return
+    tags = [_gmsh_int(lines, at + 1 + k) for k in range(3)]
+    components, items = tags[1], tags[2]
+    if components is None or items is None:
+        return
+    if components < 0 or items < 0 or items * (1 + components) * 2 > size:
+        raise FormatError(
+            f"{section} declares {items} values of {components} components, more than the "
+            f"{size}-byte file holds",
+            path,
+            at + 4,
+        )
+
+
+def check_gmsh_counts(path: Path) -> None:
+    """Refuse counts in a Gmsh file that the file's bytes cannot hold, before meshio allocates
+    or loops over them: the nodes of ``$Nodes`` (format 2) and the values and tags of data
+    sections (4294967296 tags hung meshio; a 658-byte file declaring 4e8 values took 3.7 GB)."""
     with path.open("rb") as stream:
         lines = stream.read().split(b"\n")
+    size = path.stat().st_size
     for number, line in enumerate(lines):
-        if line.strip() not in _GMSH_DATA:
-            continue
-        at = number + 1
-        for kind in ("string", "real"):
-            try:
-                count = int(lines[at])
-            except (IndexError, ValueError):
-                break  # meshio says what is wrong
-            if not 0 <= count <= GMSH_MAX_TAGS:
-                section = line.strip().decode()
-                raise FormatError(f"{section} declares {count} {kind} tags", path, at + 1)
-            at += 1 + count
+        word = line.strip()
+        if word in _GMSH_DATA:
+            _gmsh_data_counts(lines, number, size, path)
+        elif word == b"$Nodes":
+            count = _gmsh_int(lines, number + 1)  # format 2: one count (format 4: four numbers)
+            if count is not None and (count < 0 or count * 8 > size):
+                message = f"$Nodes declares {count} nodes, more than the {size}-byte file holds"
+                raise FormatError(message, path, number + 2)
 
 
 def _read_gmsh(path: Path) -> Scene:
-    check_gmsh_tags(path)
+    check_gmsh_counts(path)
     mesh = read_mesh(path, "gmsh")
     physical = mesh.cell_data.pop("gmsh:physical", None)
     mesh.cell_data.pop("gmsh:geometrical", None)

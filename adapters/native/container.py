@@ -111,7 +111,7 @@ def _document_text(document: dict[str, Any], path: Path) -> str:
     except ValueError:
         where = _non_finite_at(document)
         raise FormatError(
-            f"{where} is NaN or infinite, which JSON metadata cannot hold "
+            f"{where} is NaN or infinite, not JSON compliant: metadata cannot hold it "
             "(store it as a string, or as a property's no_data_value)",
             path,
         ) from None
@@ -233,7 +233,7 @@ def _npy_layout(member: IO[bytes], name: str) -> tuple[np.dtype[Any], tuple[int,
         else:
             raise ValueError(f"npy format version {version} is not supported")
     except (ValueError, SyntaxError, TypeError, OverflowError, EOFError, TokenError) as exc:
-        raise ValueError(f"array member {name!r} has a corrupt .npy header: {exc}") from None
+        raise ValueError(f"array member {name!r} is corrupt: its .npy header: {exc}") from None
     if dtype.hasobject or dtype.kind not in "biuf" or dtype.subdtype is not None:
         raise ValueError(f"array member {name!r} holds {dtype} values, not numbers")
     return dtype, shape, member.tell()

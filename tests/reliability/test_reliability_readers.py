@@ -34,7 +34,7 @@ REPRODUCERS = {
     "native/deflate_error.geobrep": "member 'scene.json' is corrupt",
     "native/entity_is_string.geobrep": "entities.0",
     "native/file_is_list.geobrep": "'file' must be a member name",
-    "native/npy_header_tokenerror.geobrep": "has a corrupt .npy header",
+    "native/npy_header_tokenerror.geobrep": "is corrupt: its .npy header",
     "native/scene_json_latin1.geobrep": "scene.json is not UTF-8 text",
     "native/shape_infinity.geobrep": "Infinity is not JSON",
     "ply/edge_without_vertex2.ply": "PLY edge element has no 'vertex2' property",
@@ -313,3 +313,18 @@ def test_truncated_vtp_is_an_error_not_an_empty_scene(tmp_path: Path) -> None:
     cut.write_bytes(path.read_bytes()[:3000])
     with pytest.raises(FormatError, match="VTK could not read this file"):
         geobrep.read(cut)
+
+
+def test_gmsh_data_section_declaring_more_values_than_the_file_is_refused(tmp_path: Path) -> None:
+    """A 658-byte file whose $NodeData declared 4e8 values took 3.7 GB in meshio."""
+    points = geobrep.PointSet(vertices=np.eye(3), point_data={"a": [1.0, 2.0, 3.0]})
+    path = geobrep.write(points, tmp_path / "p.msh")
+    lines = path.read_bytes().split(b"\n")
+    at = lines.index(b"$NodeData") + 8  # 1 string tag, 1 real tag, 3 integer tags: the count
+    assert lines[at] == b"3"
+    lines[at] = b"400000000"
+    path.write_bytes(b"\n".join(lines))
+    (probe,) = probe_reads([path], timeout=120)
+    assert probe.outcome == "FormatError", probe
+    assert "declares 400000000 values of 1 components" in probe.message
+    assert probe.peak_over <= memory_bound(path)
