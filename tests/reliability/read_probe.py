@@ -202,7 +202,7 @@ def zlib_bomb_vtu(path: Path, inflated: int = 3200 * MIB, lie: bool = False) -> 
     """A zlib-compressed VTU (about 5 MB) whose point array inflates to ``inflated`` bytes.
 
     Blocks of 1 MiB of zeros, as VTK lays them out; with ``lie`` each block's header declares
-    4 KiB (what the blocks inflate to is then far more than the header says).
+    4 KiB and the piece 1000 points (the blocks inflate to far more than the headers say).
     """
     block = MIB
     count = inflated // block
@@ -212,7 +212,7 @@ def zlib_bomb_vtu(path: Path, inflated: int = 3200 * MIB, lie: bool = False) -> 
     text = (
         base64.b64encode(table.tobytes()).decode() + base64.b64encode(compressed * count).decode()
     )
-    points = count * block // 24
+    points = 1000 if lie else count * block // 24  # the liar understates its points too
     path.write_text(
         '<?xml version="1.0"?>\n'
         '<VTKFile type="UnstructuredGrid" version="0.1" byte_order="LittleEndian" '

@@ -116,6 +116,11 @@ def test_every_hostile_file_is_refused_within_the_memory_bound(bombs: dict[str, 
         assert probe.outcome == "FormatError", (name, probe)
         assert probe.peak_over <= memory_bound(path), (name, probe.peak_over / MIB)
         assert probe.seconds < 30, (name, probe)  # a guard, not a timing test
+    said = dict(zip(hostile, (probe.message for probe in probes), strict=True))
+    assert (
+        "block 0 inflates to more than the 4.0 KiB" in said["zlib VTU bomb with understated blocks"]
+    )
+    assert "declares 3.1 GiB" in said["zlib VTU bomb (3.2 GB)"]
 
 
 # -- item 6: values that do not fit the declared type --------------------------------------------
