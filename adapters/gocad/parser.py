@@ -900,9 +900,10 @@ class _Parser:
                 raise self.error(
                     "TFACE needs an id, a geological type and a TSurf name", item.number
                 )
-            entry = _TFaceDraft(
-                parse_int(tokens[1]), tokens[2], _unquote(tokens[3].strip()), item.number
-            )
+            tface_id = parse_int(tokens[1])
+            if tface_id < 1:
+                raise self.error(f"TFACE id {tface_id} must be a positive number", item.number)
+            entry = _TFaceDraft(tface_id, tokens[2], _unquote(tokens[3].strip()), item.number)
             header.tfaces.append(entry)
             header.key_for, header.current = entry, None
         elif keyword in _MODEL3D_LISTS:
@@ -920,9 +921,10 @@ class _Parser:
         tokens = item.text.split(None, 2)
         if len(tokens) < 3:
             raise self.error("REGION needs an id and a name", item.number)
-        return _ListDraft(
-            keyword, _unquote(tokens[2].strip()), item.number, region_id=parse_int(tokens[1])
-        )
+        region_id = parse_int(tokens[1])
+        if region_id < 1:
+            raise self.error(f"REGION id {region_id} must be a positive number", item.number)
+        return _ListDraft(keyword, _unquote(tokens[2].strip()), item.number, region_id=region_id)
 
     def _model3d_numbers(self, item: Line, header: _Model3dDraft) -> bool:
         """A key-triangle line or a line of list ids; False when the line is neither."""

@@ -374,3 +374,16 @@ def test_a_property_header_declaring_more_values_than_the_file_holds_is_refused(
     )
     with pytest.raises(geobrep.FormatError, match="declares 100000000 values per vertex"):
         geobrep.read(path)
+
+
+@pytest.mark.parametrize(
+    ("line", "message"),
+    [("TFACE -2147483649 boundary box", "TFACE id -2147483649"), ("REGION 0 Top", "REGION id 0")],
+)
+def test_model3d_ids_must_be_positive(tmp_path: Path, line: str, message: str) -> None:
+    """The readers' fuzz run (seed 2, case 759) ended in a Patch ValidationError."""
+    path = tmp_path / "ids.ml"
+    path.write_text(f"GOCAD Model3d 1\nHEADER {{\nname: ids\n}}\n{line}\nEND\n", encoding="utf-8")
+    with pytest.raises(geobrep.FormatError, match=re.escape(message)) as caught:
+        geobrep.read(path)
+    assert caught.value.line == 5
