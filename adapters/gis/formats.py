@@ -218,6 +218,12 @@ def read_gis(path: Path, options: GisOptions, driver: str) -> Scene:
         return _read_gis(path, options, driver)
     except UnicodeDecodeError as exc:  # GDAL hands on field names or values that are not UTF-8
         raise FormatError(f"not a readable {driver} file: text is not UTF-8 ({exc})", path) from exc
+    except Exception as exc:
+        if not type(exc).__module__.startswith("pyogrio"):
+            raise
+        # GDAL finds the file corrupt while reading features (older pyogrio names some of
+        # these errors CRSError): say so, with the file
+        raise FormatError(f"not a readable {driver} file: {exc}", path) from exc
 
 
 def _read_gis(path: Path, options: GisOptions, driver: str) -> Scene:
