@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, NonNegativeInt, ValidationError
 
-from geobrep.adapters import strict_json
+from geobrep.adapters import _strict_json as strict_json
 from geobrep.adapters.casting import cast_exactly, misfit_rows
 from geobrep.errors import FormatError, GeobrepError
 from geobrep.model.crs import CRS

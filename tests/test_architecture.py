@@ -194,3 +194,77 @@ def test_core_imports_no_plugin_or_adapter_by_name(path: Path) -> None:
         and str(node.args[0].value).startswith(("geobrep.adapters", "geobrep.plugins."))
     ]
     assert not calls, f"{path.relative_to(CORE)} imports {ast.unparse(calls[0].args[0])}"
+
+
+def _private_imports(path: Path) -> list[tuple[str, str, int]]:
+    """``(private module, name, line)`` for each ``from geobrep...._x import name`` in a file."""
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        module = node.module if isinstance(node, ast.ImportFrom) else None
+        if module and module.startswith("geobrep.") and "._" in module:
+            found.extend((module, alias.name, node.lineno) for alias in node.names)
+    return found
+
+
+def _public_home(private_module: str) -> str:
+    """The public package above a private module: ``geobrep.plugins.clip`` for ``..clip._lines``."""
+    parts = private_module.split(".")
+    first_private = next(i for i, part in enumerate(parts) if part.startswith("_"))
+    return ".".join(parts[:first_private])
+
+
+_TEST_FILES = sorted(p for p in (ROOT / "tests").rglob("*.py") if "data" not in p.parts)
+
+
+@pytest.mark.parametrize("path", _TEST_FILES, ids=lambda p: str(p.relative_to(ROOT / "tests")))
+def test_tests_use_the_public_api_where_one_exists(path: Path) -> None:
+    """A test may reach into an implementation module only for what no public package exports."""
+    import importlib
+
+    offending = []
+    for module, name, line in _private_imports(path):
+        home = importlib.import_module(_public_home(module))
+        if name in getattr(home, "__all__", ()):
+            offending.append(f"line {line}: {name} from {module} (public in {home.__name__})")
+    assert not offending, "; ".join(offending)
+
+
+def _implementation_modules() -> list[Path]:
+    folders = [ROOT / "plugins", ROOT / "adapters"]
+    return sorted(
+        p
+        for folder in folders
+        for p in folder.rglob("*.py")
+        if p.name.startswith("_") and p.name != "__init__.py"
+    )
+
+
+@pytest.mark.parametrize("path", _implementation_modules(), ids=lambda p: str(p.relative_to(ROOT)))
+def test_docs_show_no_implementation_module(path: Path) -> None:
+    """Every module the docs or the README show is public: no doc names a ``_module``."""
+    package = "geobrep." + ".".join(path.relative_to(ROOT).with_suffix("").parts)
+    texts = [
+        p.read_text(encoding="utf-8") for p in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")]
+    ]
+    assert not any(package in text for text in texts), f"the docs show {package}"
+
+
+_PACKAGES = sorted(
+    p.parent
+    for folder in ("core", "plugins", "adapters")
+    for p in (ROOT / folder).rglob("__init__.py")
+)
+
+
+@pytest.mark.parametrize("package", _PACKAGES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_package_name_is_shadowed_by_its_submodule(package: Path) -> None:
+    """Importing ``pkg._x`` sets ``pkg._x`` to the module: a function of that name would vanish."""
+    submodules = {p.stem for p in package.glob("*.py") if p.name != "__init__.py"}
+    submodules |= {p.name for p in package.iterdir() if (p / "__init__.py").exists()}
+    tree = ast.parse((package / "__init__.py").read_text(encoding="utf-8"))
+    defined = {
+        node.name
+        for node in tree.body
+        if isinstance(node, ast.FunctionDef | ast.ClassDef | ast.AsyncFunctionDef)
+    }
+    assert not defined & submodules, f"{sorted(defined & submodules)} shadowed in {package.name}"

@@ -36,7 +36,7 @@ from geobrep import (
     TetMesh,
     UnknownFormatError,
 )
-from geobrep.adapters.native import container
+from geobrep.adapters.native import _container as container
 
 
 def arrays_of(value: Any, path: str = "") -> Iterator[tuple[str, np.ndarray]]:

@@ -88,7 +88,7 @@ def test_wheel_contents(wheel: Path) -> None:
     names = zipfile.ZipFile(wheel).namelist()
     assert "geobrep/__init__.py" in names
     assert "geobrep/schemas/scene.schema.json" in names
-    assert "geobrep/adapters/native/container.py" in names
+    assert "geobrep/adapters/native/_container.py" in names
     assert "geobrep/py.typed" in names
     assert not [n for n in names if n.startswith("tests/") or "/data/" in n]
     entry_points = next(n for n in names if n.endswith("entry_points.txt"))

@@ -29,7 +29,7 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters._file_format import file_format
-from geobrep.adapters.csv.table import read_points_table, write_points_table
+from geobrep.adapters.csv._table import read_points_table, write_points_table
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry
 from geobrep.model.scene import Scene
@@ -53,7 +53,7 @@ class CsvOptions(BaseModel):
 
 
 def _sniff(head: bytes) -> bool:
-    from geobrep.adapters.csv.table import looks_like_points_table
+    from geobrep.adapters.csv._table import looks_like_points_table
 
     return looks_like_points_table(head)
 

@@ -8,7 +8,7 @@ pyogrio and shapely (the ``gis`` extra) are imported only when a file is read or
 
 from __future__ import annotations
 
-from geobrep.adapters.gis.formats import gis_formats
+from geobrep.adapters.gis._formats import gis_formats
 from geobrep.host.registry import FormatRegistry
 from geobrep.plugins import hookimpl
 

@@ -2,7 +2,7 @@
 
 One format, ``gocad``, covers the family: the reader recognises each object by its
 ``GOCAD <Type>`` line (so a .ts holding a PLine still reads), the writer picks the object type
-from the extension (see :mod:`geobrep.adapters.gocad.writer`). Registered through
+from the extension (see :mod:`geobrep.adapters.gocad._writer`). Registered through
 ``geobrep_register_formats`` like any third-party format.
 """
 
@@ -27,16 +27,16 @@ def looks_like_gocad(head: bytes) -> bool:
 
 
 def _read(path: Path, options: object) -> Scene:
+    from geobrep.adapters.gocad._reader import read_gocad
     from geobrep.adapters.gocad.options import GocadOptions
-    from geobrep.adapters.gocad.reader import read_gocad
 
     assert isinstance(options, GocadOptions)
     return read_gocad(path, options)
 
 
 def _write(scene: Scene, path: Path, options: object) -> None:
+    from geobrep.adapters.gocad._writer import write_gocad
     from geobrep.adapters.gocad.options import GocadOptions
-    from geobrep.adapters.gocad.writer import write_gocad
 
     assert isinstance(options, GocadOptions)
     write_gocad(scene, path, options)
@@ -58,7 +58,7 @@ _FAMILY = frozenset({"Surface", "PolyLine", "PointSet", "TetMesh", "Block"})
 
 def _losses(scene: Scene, path: Path) -> list[str]:
     """What the object type of ``path``'s extension cannot hold (the format holds the rest)."""
-    from geobrep.adapters.gocad.objects import gocad_section
+    from geobrep.adapters.gocad._objects import gocad_section
 
     object_type, held = _HELD.get(path.suffix.lower(), ("", frozenset()))
     if not held:

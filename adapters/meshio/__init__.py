@@ -23,6 +23,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters._file_format import file_format, full_capabilities
+from geobrep.adapters._vtk_xml import check_vtu_sizes, check_xml_counts
 from geobrep.adapters.cell_layout import (
     ENTITY_ARRAY,
     LAYOUT_TYPES,
@@ -30,19 +31,18 @@ from geobrep.adapters.cell_layout import (
     layout_to_scene,
     scene_to_layout,
 )
-from geobrep.adapters.meshio.bridge import (
+from geobrep.adapters.meshio._bridge import (
     layout_from_mesh,
     mesh_from_layout,
     read_mesh,
     write_mesh,
 )
-from geobrep.adapters.meshio.header import (
+from geobrep.adapters.meshio._header import (
     embed_legacy_header,
     embed_vtu_header,
     read_legacy_header,
     vtk_field_problem,
 )
-from geobrep.adapters.vtk_xml import check_vtu_sizes, check_xml_counts
 from geobrep.errors import FormatError, MissingDependencyError
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry, NoOptions

@@ -10,7 +10,7 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters._file_format import file_format
-from geobrep.adapters.native.container import NativeDocument, load, looks_native, save
+from geobrep.adapters.native._container import NativeDocument, load, looks_native, save
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry
 from geobrep.model.scene import Scene

@@ -7,7 +7,7 @@ properties and its tensor API turns coordinates into float32, so geobrep's ``ply
 
 from __future__ import annotations
 
-from geobrep.adapters.open3d.bridge import (
+from geobrep.adapters.open3d._bridge import (
     Open3dLossWarning,
     from_open3d,
     open3d_losses,

@@ -1,7 +1,7 @@
 """Lossless PLY through ``plyfile``: binary or ASCII, float64 coordinates, every property.
 
 Point sets, surfaces and polylines of a scene go into one file with their names, ids, patch
-labels and properties (see :mod:`geobrep.adapters.ply.codec`); PLY files from other programs
+labels and properties (see :mod:`geobrep.adapters.ply._codec`); PLY files from other programs
 read as one surface keeping every vertex and face property.
 
 >>> import geobrep, tempfile, pathlib
@@ -18,7 +18,7 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters._file_format import file_format, full_capabilities
-from geobrep.adapters.ply.codec import read_ply, write_ply
+from geobrep.adapters.ply._codec import read_ply, write_ply
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatRegistry
 from geobrep.model.scene import Scene

@@ -2,7 +2,7 @@
 
 Registers the ``vtp`` format (VTK XML PolyData through pyvista: point sets, polylines and
 surfaces with names, ids, patch labels, properties and CRS) and the write-only ``png`` format
-(a rendered picture, see :class:`~geobrep.adapters.pyvista.render.RenderOptions`). pyvista is
+(a rendered picture, see :class:`~geobrep.adapters.pyvista._render.RenderOptions`). pyvista is
 imported only when one of them is used; without it they raise
 :class:`~geobrep.errors.MissingDependencyError` naming the ``viz`` extra.
 """
@@ -14,8 +14,9 @@ from pathlib import Path
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters._file_format import file_format, full_capabilities
+from geobrep.adapters._vtk_xml import check_vtu_sizes, check_xml_counts
 from geobrep.adapters.cell_layout import layout_to_scene, scene_to_layout
-from geobrep.adapters.pyvista.convert import (
+from geobrep.adapters.pyvista._convert import (
     dataset_to_layout,
     from_pyvista,
     import_pyvista,
@@ -23,8 +24,7 @@ from geobrep.adapters.pyvista.convert import (
     scene_blocks_to_pyvista,
     to_pyvista,
 )
-from geobrep.adapters.pyvista.render import RenderOptions, render_scene
-from geobrep.adapters.vtk_xml import check_vtu_sizes, check_xml_counts
+from geobrep.adapters.pyvista._render import RenderOptions, render_scene
 from geobrep.errors import FormatError
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec

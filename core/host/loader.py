@@ -8,7 +8,7 @@ exception, :class:`BaseException` subclasses included, but :class:`KeyboardInter
 :class:`~geobrep.host.registry.GeobrepPluginWarning` and the plugin is marked ``"failed"``.
 
 The import and the hooks of a plugin from another distribution run in a daemon thread
-(:func:`geobrep.host.isolation.call_bounded`): one that does not finish within
+(:func:`geobrep.host._isolation.call_bounded`): one that does not finish within
 ``GEOBREP_PLUGIN_TIMEOUT`` seconds (default 10) is reported, skipped and abandoned. geobrep's
 own plugins are imported directly and their items are marked ``builtin``.
 
@@ -39,7 +39,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from geobrep.errors import PluginError
 from geobrep.hookspecs import PROJECT_NAME, GeobrepSpecs
-from geobrep.host.isolation import (
+from geobrep.host._isolation import (
     STRICT_ENV,
     TIMEOUT_ENV,
     PluginTimeoutError,

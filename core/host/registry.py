@@ -32,7 +32,7 @@ from pydantic import (
 )
 
 from geobrep.errors import GeobrepError, OptionsError, PluginError, UnknownFormatError
-from geobrep.host.isolation import (
+from geobrep.host._isolation import (
     SNIFF_TIMEOUT_ENV,
     PluginTimeoutError,
     call_bounded,

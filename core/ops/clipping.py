@@ -5,7 +5,7 @@ side (``keep="negative"`` or ``"positive"``) or splits into both (``keep="both"`
 ``(negative, positive)``). A clipped entity has the type of the input; ``None`` means nothing is
 left. For a :class:`~geobrep.Scene`, the spatial index decides which entities straddle the
 plane: only those are cut, the others are kept or dropped whole, and the B-Rep topology is carried
-over (:mod:`geobrep.ops.clip_topology`): each cut block is closed again by a cap patch between it
+over (:mod:`geobrep.ops._clip_topology`): each cut block is closed again by a cap patch between it
 and the universe.
 
 The cutting itself is done by plugins: one :class:`~geobrep.plugins.ClipperSpec` per entity type,
@@ -419,7 +419,7 @@ def _clip_scene(
     registry: ClipperRegistry,
     choice: Mapping[str, str],
 ) -> ClipOutput:
-    from geobrep.ops.clip_topology import carry_topology
+    from geobrep.ops._clip_topology import carry_topology
 
     wanted = halves(keep)
     context.drafts = {side: SceneDraft(side) for side in wanted}

@@ -22,7 +22,7 @@ __all__ = ["geobrep_register_builders"]
 @hookimpl
 def geobrep_register_builders(registry: BuilderRegistry) -> None:
     from geobrep.plugins import BuilderSpec
-    from geobrep.plugins.blocks.builder import build_blocks
+    from geobrep.plugins.blocks._builder import build_blocks
     from geobrep.plugins.blocks.options import BlockBuilderOptions
 
     registry.add(

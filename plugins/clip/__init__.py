@@ -21,11 +21,14 @@ __all__ = ["geobrep_register_clippers"]
 def geobrep_register_clippers(registry: ClipperRegistry) -> None:
     """Register the built-in clippers (modules are imported here, on first use of a registry)."""
     from geobrep.plugins import ClipperSpec
+    from geobrep.plugins.clip._blocks import clip_block, section_block
+    from geobrep.plugins.clip._lines import clip_polyline, section_polyline
+    from geobrep.plugins.clip._nurbs import clip_nurbs
+    from geobrep.plugins.clip._octree import clip_octree
+    from geobrep.plugins.clip._points import clip_pointset, section_pointset
+    from geobrep.plugins.clip._polygons import clip_polygon, section_polygon
+    from geobrep.plugins.clip._surfaces import clip_surface, section_surface
     from geobrep.plugins.clip.annotations import clip_annotation
-    from geobrep.plugins.clip.blocks import clip_block, section_block
-    from geobrep.plugins.clip.lines import clip_polyline, section_polyline
-    from geobrep.plugins.clip.nurbs import clip_nurbs
-    from geobrep.plugins.clip.octree import clip_octree
     from geobrep.plugins.clip.options import (
         AnnotationClipOptions,
         ClipOptions,
@@ -33,9 +36,6 @@ def geobrep_register_clippers(registry: ClipperRegistry) -> None:
         OctreeClipOptions,
         SurfaceClipOptions,
     )
-    from geobrep.plugins.clip.points import clip_pointset, section_pointset
-    from geobrep.plugins.clip.polygons import clip_polygon, section_polygon
-    from geobrep.plugins.clip.surfaces import clip_surface, section_surface
 
     # name, entity type, clipper, section (or None), options model, description
     table: list[tuple[str, str, Callable[..., Any], Callable[..., Any] | None, type, str]] = [

@@ -23,10 +23,10 @@ from numpy.typing import NDArray
 from geobrep import Annotation, PolyLine
 from geobrep.geometry import Plane
 from geobrep.plugins import ClipContext, Keep, halves, pack_halves
+from geobrep.plugins.clip._lines import cut_segments
+from geobrep.plugins.clip._sides import vertex_sides
 from geobrep.plugins.clip.glyphs import ADVANCE, CAP_HEIGHT, DESCENDER, WIDTH, text_strokes
-from geobrep.plugins.clip.lines import cut_segments
 from geobrep.plugins.clip.options import AnnotationClipOptions, tolerance_of
-from geobrep.plugins.clip.sides import vertex_sides
 
 __all__ = ["annotation_polyline", "annotation_strokes", "clip_annotation"]
 

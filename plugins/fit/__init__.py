@@ -27,26 +27,26 @@ from geobrep.plugins.fit.options import (
 __all__ = ["geobrep_register_fitters"]
 
 
-def _skinning(entities: list[Any], options: SkinningOptions) -> Any:
-    from geobrep.plugins.fit.skinning_fitter import fit_skinning
+def _run_skinning(entities: list[Any], options: SkinningOptions) -> Any:
+    from geobrep.plugins.fit._skinning_fitter import fit_skinning
 
     return fit_skinning(entities, options)
 
 
-def _approximation(entities: list[Any], options: ApproximationOptions) -> Any:
-    from geobrep.plugins.fit.approximation import fit_approximation
+def _run_approximation(entities: list[Any], options: ApproximationOptions) -> Any:
+    from geobrep.plugins.fit._approximation import fit_approximation
 
     return fit_approximation(entities, options)
 
 
-def _kriging(entities: list[Any], options: KrigingOptions) -> Any:
+def _run_kriging(entities: list[Any], options: KrigingOptions) -> Any:
     from geobrep.plugins.fit.kriging import fit_kriging
 
     return fit_kriging(entities, options)
 
 
-def _hybrid(entities: list[Any], options: HybridOptions) -> Any:
-    from geobrep.plugins.fit.hybrid import fit_hybrid
+def _run_hybrid(entities: list[Any], options: HybridOptions) -> Any:
+    from geobrep.plugins.fit._hybrid import fit_hybrid
 
     return fit_hybrid(entities, options)
 
@@ -57,13 +57,13 @@ def geobrep_register_fitters(registry: FitterRegistry) -> None:
     both = ("PointSet", "PolyLine")
     # name, function, input types, options model, description
     table: list[tuple[str, Callable[..., Any], tuple[str, ...], type, str]] = [
-        ("skinning", _skinning, both, SkinningOptions,
+        ("skinning", _run_skinning, both, SkinningOptions,
          "NURBS skinning: interpolate ordered sections, exact at every point"),
-        ("approximation", _approximation, both, ApproximationOptions,
+        ("approximation", _run_approximation, both, ApproximationOptions,
          "NURBS least squares with smoothing, ε-driven net size, boundary curves"),
-        ("kriging", _kriging, both, KrigingOptions,
+        ("kriging", _run_kriging, both, KrigingOptions,
          "Ordinary/universal kriging onto a grid (prediction + variance)"),
-        ("hybrid", _hybrid, ("PointSet",), HybridOptions,
+        ("hybrid", _run_hybrid, ("PointSet",), HybridOptions,
          "Skin the dense core, approximate the sparse rim against it (Li 2011)"),
     ]  # fmt: skip
     for name, function, input_types, options, description in table:

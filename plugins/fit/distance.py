@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 
 from geobrep import NurbsSurface, Surface
 from geobrep.geometry.distance import closest_points_on_triangles, mesh_distances
-from geobrep.plugins.fit.projection import project_points
+from geobrep.plugins.fit._projection import project_points
 
 __all__ = ["closest_points_on_triangles", "mesh_distances", "surface_distances"]
 

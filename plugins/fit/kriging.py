@@ -39,17 +39,17 @@ from scipy.spatial.distance import cdist, pdist, squareform
 from geobrep import Entity, Surface
 from geobrep.errors import DegenerateGeometryError, OptionsError
 from geobrep.plugins import FitResult
-from geobrep.plugins.fit.approximation import collect_points
-from geobrep.plugins.fit.distance import mesh_distances
-from geobrep.plugins.fit.lsq import single_threaded_blas
-from geobrep.plugins.fit.options import KrigingOptions
-from geobrep.plugins.fit.report import accuracy_report
-from geobrep.plugins.fit.variogram import (
+from geobrep.plugins.fit._approximation import collect_points
+from geobrep.plugins.fit._lsq import single_threaded_blas
+from geobrep.plugins.fit._variogram import (
     Variogram,
     experimental_variogram,
     fit_variogram,
     variogram_from_options,
 )
+from geobrep.plugins.fit.distance import mesh_distances
+from geobrep.plugins.fit.options import KrigingOptions
+from geobrep.plugins.fit.report import accuracy_report
 
 __all__ = ["fit_kriging", "krige"]
 

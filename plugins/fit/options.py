@@ -79,7 +79,7 @@ class BoundaryCurve(BaseModel):
         ``"u0"``/``"u1"``: the edges at the first/last u (running along v); ``"v0"``/``"v1"``: at
         the first/last v (running along u).
         """
-        from geobrep.plugins.fit.curves import surface_boundary
+        from geobrep.plugins.fit._curves import surface_boundary
 
         curve = surface_boundary(surface, side)
         return cls(

@@ -20,7 +20,7 @@ __all__ = ["VoxelizeOptions", "geobrep_register_voxelizers"]
 
 
 def _voxelize(scene: Scene, options: Any) -> LinearOctree:
-    from geobrep.plugins.voxelize.builder import voxelize_scene
+    from geobrep.plugins.voxelize._builder import voxelize_scene
 
     octree: LinearOctree = voxelize_scene(scene, options).octrees[-1]
     return octree

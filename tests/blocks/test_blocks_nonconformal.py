@@ -11,7 +11,7 @@ from blocks_models import box_model, grid_surface, vertical_fault, wedge_model
 from geobrep import Scene, Surface
 from geobrep.errors import TopologyError
 from geobrep.ops.building import build_blocks
-from geobrep.plugins.blocks.conformity import (
+from geobrep.plugins.blocks._conformity import (
     NonConformalError,
     point_triangle_distance,
     triangles_intersect,

@@ -13,23 +13,23 @@ from blocks_models import box_model, closed_cube, vertical_fault
 import geobrep
 from geobrep import Scene, Surface
 from geobrep.errors import TopologyError
-from geobrep.plugins.blocks.arcs import chain_arcs
-from geobrep.plugins.blocks.assembly import Assembly, assemble
-from geobrep.plugins.blocks.broad_phase import overlapping_pairs
-from geobrep.plugins.blocks.conformity import (
+from geobrep.plugins.blocks._arcs import chain_arcs
+from geobrep.plugins.blocks._assembly import Assembly, assemble
+from geobrep.plugins.blocks._broad_phase import overlapping_pairs
+from geobrep.plugins.blocks._conformity import (
     _segment_distance,
     _segment_pairs_hit,
     point_triangle_distance,
     separated,
     triangles_intersect,
 )
-from geobrep.plugins.blocks.measures import PatchMeasures, measure_patches
-from geobrep.plugins.blocks.patches import PatchSplit, split_patches
-from geobrep.plugins.blocks.radial_sort import sort_arcs
-from geobrep.plugins.blocks.soup import Soup, build_soup
-from geobrep.plugins.blocks.traversal import traverse
-from geobrep.plugins.blocks.universe import find_universe
-from geobrep.plugins.blocks.validation import Validation, validate_scene
+from geobrep.plugins.blocks._measures import PatchMeasures, measure_patches
+from geobrep.plugins.blocks._patches import PatchSplit, split_patches
+from geobrep.plugins.blocks._radial_sort import sort_arcs
+from geobrep.plugins.blocks._soup import Soup, build_soup
+from geobrep.plugins.blocks._traversal import traverse
+from geobrep.plugins.blocks._universe import find_universe
+from geobrep.plugins.blocks._validation import Validation, validate_scene
 
 
 @dataclass

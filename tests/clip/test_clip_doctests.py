@@ -12,7 +12,7 @@ MODULES = [
     "geobrep.cli.clip",
     *(
         f"geobrep.plugins.clip.{name}"
-        for name in ("sides", "triangles", "loops", "caps", "lines", "annotations", "glyphs")
+        for name in ("_sides", "_triangles", "_loops", "_caps", "_lines", "annotations", "glyphs")
     ),
 ]
 

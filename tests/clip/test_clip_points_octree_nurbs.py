@@ -8,7 +8,7 @@ import pytest
 from geobrep import LinearOctree, NurbsSurface, Plane, PointSet
 from geobrep.errors import DegenerateGeometryError
 from geobrep.ops.clipping import clip, section
-from geobrep.plugins.clip.nurbs import trimmed_mesh
+from geobrep.plugins.clip._nurbs import trimmed_mesh
 
 
 def test_points_on_the_plane_belong_to_both_sides() -> None:

@@ -12,7 +12,7 @@ import pytest
 import geobrep
 from geobrep import Surface
 from geobrep.geometry import mesh
-from geobrep.plugins.clip.welding import UnweldedSurfaceWarning, closed_once_welded
+from geobrep.plugins.clip._welding import UnweldedSurfaceWarning, closed_once_welded
 
 CORNERS = np.array(
     [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float

@@ -12,8 +12,8 @@ from geobrep import NurbsSurface, PointSet
 from geobrep.datasets import dome_elevation
 from geobrep.errors import DegenerateGeometryError, EntityValidationError, OptionsError
 from geobrep.ops.fitting import fit
-from geobrep.plugins.fit.design import normal_equations, surface_design_matrix
-from geobrep.plugins.fit.knots import uniform_knots
+from geobrep.plugins.fit._design import normal_equations, surface_design_matrix
+from geobrep.plugins.fit._knots import uniform_knots
 from geobrep.plugins.fit.options import ApproximationOptions, BoundaryCurve
 
 
@@ -243,8 +243,8 @@ class TestGrid:
         return np.stack([x, y, z], axis=-1).reshape(-1, 3) + UTM
 
     def test_separable_solve_equals_general_least_squares(self) -> None:
-        from geobrep.plugins.fit.approximation import approximate_points, solve_net
-        from geobrep.plugins.fit.frame import LocalFrame
+        from geobrep.plugins.fit._approximation import approximate_points, solve_net
+        from geobrep.plugins.fit._frame import LocalFrame
 
         points = self.grid()
         options = ApproximationOptions(control_points=(12, 14), smoothing=0.0, grid_shape=(40, 45))

@@ -7,12 +7,12 @@ from fit_helpers import UTM, sphere_octant
 
 from geobrep import NurbsSurface, Surface
 from geobrep.geometry.nurbs import NurbsNet
+from geobrep.plugins.fit._projection import invert_planar_map, project_points
 from geobrep.plugins.fit.distance import (
     closest_points_on_triangles,
     mesh_distances,
     surface_distances,
 )
-from geobrep.plugins.fit.projection import invert_planar_map, project_points
 
 
 def test_distances_to_a_rational_sphere_are_exact() -> None:

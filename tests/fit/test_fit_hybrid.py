@@ -11,9 +11,9 @@ from geobrep import NurbsSurface, PointSet
 from geobrep.datasets import dome_elevation
 from geobrep.errors import DegenerateGeometryError, OptionsError
 from geobrep.ops.fitting import FitResult, fit
-from geobrep.plugins.fit.frame import LocalFrame
-from geobrep.plugins.fit.hybrid import layout_knots
-from geobrep.plugins.fit.split import core_by_density
+from geobrep.plugins.fit._frame import LocalFrame
+from geobrep.plugins.fit._hybrid import layout_knots
+from geobrep.plugins.fit._split import core_by_density
 
 
 @pytest.fixture(scope="module")

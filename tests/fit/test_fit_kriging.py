@@ -12,13 +12,13 @@ from geobrep import Surface
 from geobrep.errors import DegenerateGeometryError, OptionsError
 from geobrep.ops.fitting import fit
 from geobrep.plugins.fit import kriging
-from geobrep.plugins.fit.kriging import krige
-from geobrep.plugins.fit.variogram import (
+from geobrep.plugins.fit._variogram import (
     Variogram,
     experimental_variogram,
     fit_variogram,
     variogram_from_options,
 )
+from geobrep.plugins.fit.kriging import krige
 
 pykrige_ok = pytest.importorskip("pykrige.ok")
 pykrige_uk = pytest.importorskip("pykrige.uk")

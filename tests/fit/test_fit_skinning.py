@@ -9,9 +9,9 @@ import geobrep
 from geobrep import PointSet, PolyLine
 from geobrep.errors import DegenerateGeometryError, EntityValidationError, OptionsError
 from geobrep.ops.fitting import fit
-from geobrep.plugins.fit.curves import interpolate_curve, surface_boundary
-from geobrep.plugins.fit.knots import insert_knots, merge_knots, missing_knots
-from geobrep.plugins.fit.skinning import rows_from_lattice, skin_rows
+from geobrep.plugins.fit._curves import interpolate_curve, surface_boundary
+from geobrep.plugins.fit._knots import insert_knots, merge_knots, missing_knots
+from geobrep.plugins.fit._skinning import rows_from_lattice, skin_rows
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ import pytest
 from formats_support import rich_scene
 
 from geobrep.adapters.cell_layout import layout_to_scene, scene_to_layout
-from geobrep.adapters.meshio import bridge
+from geobrep.adapters.meshio import _bridge as bridge
 from geobrep.errors import FormatError, MissingDependencyError
 from geobrep.host.capabilities import restrict_scene
 from geobrep.model.entities import LinearOctree, PointSet, PolyLine, Surface

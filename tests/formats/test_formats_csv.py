@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import geobrep
-from geobrep.adapters.csv.table import looks_like_points_table
+from geobrep.adapters.csv._table import looks_like_points_table
 from geobrep.errors import FormatError
 from geobrep.host.capabilities import capability_losses
 from geobrep.plugins import registries

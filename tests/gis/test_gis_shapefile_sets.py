@@ -15,7 +15,7 @@ from geobrep.ops.io import read, write
 
 pytest.importorskip("pyogrio")
 
-from geobrep.adapters.gis import formats as gis_formats
+from geobrep.adapters.gis import _formats as gis_formats
 
 
 def markers(n: int, crs: str | None = "EPSG:32631") -> geobrep.Scene:

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 import geobrep
-from geobrep.adapters.gocad.parser import GocadWarning
+from geobrep.adapters.gocad._parser import GocadWarning
 
 DATA = Path(__file__).resolve().parent.parent / "data" / "gocad"
 FILES = sorted(p.name for p in DATA.iterdir() if p.suffix != ".md")

@@ -9,11 +9,11 @@ import pytest
 
 MODULES = [
     "geobrep.model.arcs",
-    "geobrep.adapters.gocad.headers",
-    "geobrep.adapters.gocad.lexer",
-    "geobrep.adapters.gocad.numbers",
+    "geobrep.adapters.gocad._headers",
+    "geobrep.adapters.gocad._lexer",
+    "geobrep.adapters.gocad._numbers",
     "geobrep.adapters.gocad.options",
-    "geobrep.adapters.gocad.regions",
+    "geobrep.adapters.gocad._regions",
 ]
 
 

@@ -17,7 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import geobrep
-from geobrep.adapters.gocad.parser import GocadWarning
+from geobrep.adapters.gocad._parser import GocadWarning
 from geobrep.model.base import arrays_identical
 
 SMALL = [

@@ -10,7 +10,7 @@ import pytest
 
 import geobrep
 from geobrep.adapters.gocad import looks_like_gocad
-from geobrep.adapters.gocad.parser import GocadWarning
+from geobrep.adapters.gocad._parser import GocadWarning
 
 
 def write(tmp_path: Path, text: str, name: str = "x.ts", crlf: bool = False) -> Path:

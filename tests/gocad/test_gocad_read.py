@@ -11,7 +11,7 @@ from gocad_files import DATA, FILES, read_quietly
 
 import geobrep
 from geobrep import Block, PointSet, PolyLine, Scene, Surface, TetMesh
-from geobrep.adapters.gocad.parser import GocadWarning
+from geobrep.adapters.gocad._parser import GocadWarning
 from geobrep.model.arcs import build_corners_and_arcs
 from geobrep.model.topology import Topology
 

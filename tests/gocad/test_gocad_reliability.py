@@ -19,8 +19,8 @@ import pytest
 from gocad_files import DATA
 
 import geobrep
-from geobrep.adapters.gocad.lexer import Source, split_tokens
-from geobrep.adapters.gocad.parser import GocadWarning
+from geobrep.adapters.gocad._lexer import Source, split_tokens
+from geobrep.adapters.gocad._parser import GocadWarning
 
 TESTS_DATA = DATA.parent
 RELIABILITY = TESTS_DATA / "reliability" / "gocad"

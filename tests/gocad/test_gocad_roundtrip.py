@@ -10,7 +10,7 @@ from gocad_files import DATA, FILES, read_quietly, write_quietly
 
 import geobrep
 from geobrep import CRS, Block, PointSet, PolyLine, Property, Scene, Surface, TetMesh
-from geobrep.adapters.gocad.parser import GocadWarning
+from geobrep.adapters.gocad._parser import GocadWarning
 from geobrep.host.capabilities import without_read_losses
 from geobrep.model.base import arrays_identical
 

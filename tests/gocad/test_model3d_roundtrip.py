@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 import geobrep
 from geobrep import Scene, Surface
-from geobrep.adapters.gocad.parser import GocadWarning
+from geobrep.adapters.gocad._parser import GocadWarning
 from geobrep.model.topology import Topology
 
 MODELS = sorted(p.name for p in DATA.glob("*.ml"))

@@ -17,7 +17,7 @@ from gocad_files import DATA, read_quietly, write_quietly
 
 import geobrep
 from geobrep import TetMesh
-from geobrep.adapters.gocad.parser import GocadWarning
+from geobrep.adapters.gocad._parser import GocadWarning
 
 OPENGEODE = Path(__file__).resolve().parent.parent / "data" / "opengeode"
 

@@ -22,7 +22,7 @@ import pytest
 import geobrep
 from geobrep.errors import PluginError
 from geobrep.host import loader as plugin_loader
-from geobrep.host.isolation import (
+from geobrep.host._isolation import (
     DEFAULT_PLUGIN_TIMEOUT,
     PluginTimeoutError,
     call_bounded,

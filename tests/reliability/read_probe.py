@@ -122,7 +122,7 @@ def _native_members(scene_json: dict[str, object], members: dict[str, bytes]) ->
 
 def _point_set_document(shape: tuple[int, ...]) -> dict[str, object]:
     import geobrep
-    from geobrep.adapters.native.container import NativeDocument
+    from geobrep.adapters.native import NativeDocument
 
     scene = geobrep.Scene(entities=[geobrep.PointSet(vertices=np.zeros((1, 3)), name="p")])
     document = NativeDocument(scene=scene).model_dump(

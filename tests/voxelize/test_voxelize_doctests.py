@@ -9,10 +9,10 @@ import pytest
 
 MODULES = [
     "geobrep.geometry.morton",
-    "geobrep.plugins.voxelize.rasterize",
-    "geobrep.plugins.voxelize.depth_buffers",
-    "geobrep.plugins.voxelize.parity",
-    "geobrep.plugins.voxelize.merge",
+    "geobrep.plugins.voxelize._rasterize",
+    "geobrep.plugins.voxelize._depth_buffers",
+    "geobrep.plugins.voxelize._parity",
+    "geobrep.plugins.voxelize._merge",
 ]
 
 

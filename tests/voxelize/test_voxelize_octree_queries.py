@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 from geobrep import LinearOctree
 from geobrep.errors import EntityValidationError, MissingDependencyError, OptionsError
 from geobrep.geometry.morton import morton_decode, morton_encode, octant_span
-from geobrep.plugins.voxelize.emission import Leaves
-from geobrep.plugins.voxelize.merge import merge_full_siblings
+from geobrep.plugins.voxelize._emission import Leaves
+from geobrep.plugins.voxelize._merge import merge_full_siblings
 
 UTM = np.array([450_000.0, 6_700_000.0, -800.0])
 

@@ -13,12 +13,12 @@ from shapes import winding_numbers
 from geobrep import LinearOctree, Surface
 from geobrep.geometry.morton import morton_decode, morton_encode
 from geobrep.ops.voxelization import voxelize
-from geobrep.plugins.voxelize.classify import PriorityClassifier
-from geobrep.plugins.voxelize.depth_buffers import DepthBufferClassifier, depth_buffers
-from geobrep.plugins.voxelize.emission import Leaves, emit_leaves
-from geobrep.plugins.voxelize.merge import merge_full_siblings
-from geobrep.plugins.voxelize.parity import ExactClassifier
-from geobrep.plugins.voxelize.rasterize import ray_crossings
+from geobrep.plugins.voxelize._classify import PriorityClassifier
+from geobrep.plugins.voxelize._depth_buffers import DepthBufferClassifier, depth_buffers
+from geobrep.plugins.voxelize._emission import Leaves, emit_leaves
+from geobrep.plugins.voxelize._merge import merge_full_siblings
+from geobrep.plugins.voxelize._parity import ExactClassifier
+from geobrep.plugins.voxelize._rasterize import ray_crossings
 
 DEPTH = 5
 

@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from geobrep.ops.voxelization import voxelize
-from geobrep.plugins.voxelize.rasterize import ray_crossings
+from geobrep.plugins.voxelize._rasterize import ray_crossings
 
 
 def all_counts(vertices: np.ndarray, faces: np.ndarray, resolution: int) -> list[np.ndarray]:

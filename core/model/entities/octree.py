@@ -272,7 +272,7 @@ class LinearOctree(Entity):
         every ``cell_data`` property. ``"image"``: the finest grid with cell array ``label``
         (``-1`` outside; ``1`` inside without labels) — ``8**depth`` cells, so keep depth small.
         """
-        from geobrep.model.entities.octree_export import octree_to_pyvista
+        from geobrep.model.entities._octree_export import octree_to_pyvista
 
         return octree_to_pyvista(self, kind)
 
@@ -281,13 +281,13 @@ class LinearOctree(Entity):
 
         Larger leaves are split into voxels of that level; smaller ones mark their voxel.
         """
-        from geobrep.model.entities.octree_export import octree_to_open3d
+        from geobrep.model.entities._octree_export import octree_to_open3d
 
         return octree_to_open3d(self, level)
 
     def to_open3d_octree(self, level: int | None = None) -> open3d.geometry.Octree:
         """An open3d ``Octree`` built from :meth:`to_open3d` (extra ``open3d``)."""
-        from geobrep.model.entities.octree_export import octree_to_open3d_octree
+        from geobrep.model.entities._octree_export import octree_to_open3d_octree
 
         return octree_to_open3d_octree(self, level)
 

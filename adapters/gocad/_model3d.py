@@ -1,0 +1,455 @@
+"""Model3d (.ml) semantics: TFACE identity by key triangle, REGION signs, LAYER/FAULT_BLOCK.
+
+* The i-th header ``TFACE k <type> <tsurf>`` is the i-th TFACE part of the TSurf called
+  ``<tsurf>``; its three coordinate lines are a **key triangle**: one triangle of that part in
+  the same vertex order (often not the first triangle).
+* ``REGION`` lists signed TFACE ids: ``+k`` means the region lies on the side the normal of
+  TFACE k's key triangle points to, in z-up coordinates (after ``ZPOSITIVE Depth`` is negated).
+  ``+k ... -k`` in one region is a surface inside it; the ``Universe`` region is the outside.
+* Corners and arcs are rebuilt from the patches (:mod:`geobrep.model.arcs`), with the BSTONE
+  vertices as extra corners; coincident vertices of different TSurfs are joined with a tolerance.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep.adapters.gocad._objects import gocad_section
+from geobrep.adapters.gocad._parser import GocadObject
+from geobrep.adapters.gocad._records import (
+    Diagnostics,
+    Model3dHeader,
+    ModelList,
+    RegionEntry,
+    TFaceEntry,
+)
+from geobrep.adapters.gocad.options import GocadOptions
+from geobrep.geometry.bbox import column_extremes
+from geobrep.model.arcs import corners_and_arcs
+from geobrep.model.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
+from geobrep.model.orientation import orient_patches
+from geobrep.model.scene import Group
+from geobrep.model.topology import Corner, Patch, Topology
+
+__all__ = ["Model3dParts", "attach_model3d", "border_topology", "find_key_triangle"]
+
+_LIST_KINDS = {
+    "LAYER": "layer",
+    "FAULT_BLOCK": "fault_block",
+    "SURFACE": "feature",
+    "FAULT": "fault",
+    "BOUNDARY": "boundary",
+    "UNIT": "unit",
+}
+
+
+class Model3dParts(NamedTuple):
+    """What a Model3d header adds to a scene."""
+
+    topology: Topology
+    blocks: list[Entity]
+    groups: list[Group]
+    metadata: dict[str, Any]  # the scene's metadata["gocad"]["model3d"]
+    surfaces: list[Surface]  # the member surfaces (turned to agree with their key triangles)
+
+
+def find_key_triangle(
+    surface: Surface, label: int, key: NDArray[np.float64], tolerance: float
+) -> tuple[int | None, bool]:
+    """``(face index, reversed)`` of the triangle of patch ``label`` matching ``key`` (3, 3).
+
+    A match keeps the vertex order up to a cyclic rotation; ``reversed`` is true when only the
+    opposite order matches. ``(None, False)`` when no triangle matches.
+    """
+    faces = surface.patch_faces(label)
+    if faces.size == 0:
+        return None, False
+    corners = surface.vertices[surface.faces[faces][:, :3]]  # (m, 3, 3)
+    for reverse in (False, True):
+        target = key[::-1] if reverse else key
+        for shift in range(3):
+            rolled = np.roll(target, shift, axis=0)
+            close = (np.abs(corners - rolled[None]) <= tolerance).all(axis=(1, 2))
+            hit = np.flatnonzero(close)
+            if hit.size:
+                return int(faces[hit[0]]), reverse
+    return None, False
+
+
+def _tsurf_names(surface: Surface) -> list[str]:
+    names = [surface.name]
+    for key, value in gocad_section(surface.metadata).get("header", []):
+        if key == "name_in_model_list":
+            names.insert(0, str(value))
+    return names
+
+
+def attach_model3d(
+    model: GocadObject,
+    surfaces: list[Surface],
+    first_id: int,
+    z_sign: float,
+    options: GocadOptions,
+    builder: Diagnostics,
+) -> Model3dParts:
+    """Topology, blocks, groups, scene metadata and the member surfaces of a Model3d header.
+
+    With ``options.repair`` (the default) each TFACE's triangles are turned to agree with its
+    key triangle, so the surfaces returned may differ from those given.
+    """
+    header = model.model3d
+    diagonal = _diagonal(surfaces)
+    matched = _TFaceMatcher(surfaces, z_sign, 1e-9 * max(diagonal, 1.0), builder)
+    matched.match_all(header)
+    if options.repair:
+        surfaces = _orient_by_key_triangles(surfaces, matched.key_faces, matched.patches, builder)
+    blocks, region_block = _region_blocks(header, matched, first_id, builder)
+    patches = _with_blocks(matched.patches, blocks)
+    groups = _groups(header.lists, region_block, patches, builder)
+    topology = _rebuilt_topology(
+        surfaces, patches, options.merge_tolerance_for(diagonal), builder.warn
+    )
+    return Model3dParts(topology, blocks, groups, _model_metadata(model), surfaces)
+
+
+def _diagonal(surfaces: Sequence[Surface]) -> float:
+    """The bounding-box diagonal of the surfaces' vertices (1 when they have none)."""
+    points = [s.vertices for s in surfaces if s.n_vertices]
+    if not points:
+        return 1.0
+    return _box_diagonal(np.concatenate(points))
+
+
+def _box_diagonal(points: NDArray[np.float64]) -> float:
+    """The bounding-box diagonal of ``points``, finite even when coordinates near the float64
+    limit (``1e308``) make it overflow (it is then the largest float, so tolerances derived
+    from it stay finite)."""
+    low, high = column_extremes(points)
+    with np.errstate(over="ignore", invalid="ignore"):
+        diagonal = float(np.hypot.reduce(high - low))
+    return diagonal if np.isfinite(diagonal) else float(np.finfo(np.float64).max)
+
+
+@dataclass
+class _TFaceMatcher:
+    """Header TFACEs matched to the TFACE parts of the member TSurfs, one patch each."""
+
+    surfaces: list[Surface]
+    z_sign: float
+    key_tolerance: float
+    builder: Diagnostics
+    patches: list[Patch] = field(default_factory=list)
+    flipped: dict[int, bool] = field(default_factory=dict)  # TFACE id -> key triangle reversed
+    key_faces: dict[int, dict[int, int | None]] = field(default_factory=dict)
+    """surface id -> patch label -> face index of its key triangle (None: not found)."""
+
+    def match_all(self, header: Model3dHeader) -> None:
+        by_name: dict[str, Surface] = {}
+        listed: set[str] = set()  # names given by name_in_model_list
+        for surface in self.surfaces:
+            names = _tsurf_names(surface)
+            if len(names) > 1:
+                listed.add(names[0])
+            for name in names:
+                by_name.setdefault(name, surface)
+        declared = set(header.tsurfs)
+        seen_parts: dict[str, int] = {}
+        for entry in header.tfaces:
+            surface = self._surface_of(entry, by_name, listed, declared)
+            label = seen_parts.get(entry.tsurf, 0)
+            seen_parts[entry.tsurf] = label + 1
+            self._match(entry, surface, label)
+
+    def _surface_of(
+        self, entry: TFaceEntry, by_name: dict[str, Surface], listed: set[str], declared: set[str]
+    ) -> Surface:
+        """The TSurf a header TFACE names (warnings when the header does not declare it well)."""
+        builder = self.builder
+        if entry.tsurf not in declared:
+            builder.warn(
+                f"TFACE {entry.id} names {entry.tsurf!r}, which has no TSURF line", entry.line
+            )
+            declared.add(entry.tsurf)
+        found = by_name.get(entry.tsurf)
+        if found is None:
+            raise builder.error(
+                f"TFACE {entry.id} names TSurf {entry.tsurf!r}, which is not in the file",
+                entry.line,
+            )
+        if entry.tsurf not in listed:
+            builder.warn(
+                f"TSurf {entry.tsurf!r} has no name_in_model_list: matched by its name", entry.line
+            )
+            listed.add(entry.tsurf)
+        return found
+
+    def _match(self, entry: TFaceEntry, surface: Surface, label: int) -> None:
+        """The patch of TFACE ``entry``: part ``label`` of ``surface``, its key triangle found."""
+        if label >= surface.n_patches:
+            raise self.builder.error(
+                f"TFACE {entry.id} is part {label + 1} of TSurf {entry.tsurf!r}, "
+                f"which has {surface.n_patches} TFACE part(s)",
+                entry.line,
+            )
+        key = np.asarray(entry.key, dtype=np.float64)
+        key[:, 2] *= self.z_sign
+        face, reverse = find_key_triangle(surface, label, key, self.key_tolerance)
+        if face is None:
+            self.builder.warn(
+                f"the key triangle of TFACE {entry.id} is not a triangle of part {label + 1} "
+                f"of {entry.tsurf!r}; its REGION signs are taken as they are",
+                entry.line,
+            )
+        self.flipped[entry.id] = reverse
+        self.key_faces.setdefault(int(surface.id or 0), {})[label] = face
+        gocad: dict[str, Any] = {"geological_type": entry.type, "key_triangle": face}
+        if reverse:
+            gocad["key_reversed"] = True
+        self.patches.append(
+            Patch(
+                id=entry.id,
+                surface=int(surface.id or 0),
+                label=label,
+                name=f"{entry.tsurf}:{label}",
+                metadata={"gocad": gocad},
+            )
+        )
+
+
+def _region_sides(
+    region: RegionEntry, matched: _TFaceMatcher, patch_ids: set[int], builder: Diagnostics
+) -> tuple[PatchSide, ...]:
+    """A REGION's signed TFACE ids as patch sides (turned with their flipped TFACEs), each
+    once, in the order first listed: one warning for all the ids a REGION repeats."""
+    values = np.asarray(region.items, dtype=np.int64)
+    unique, first = np.unique(values, return_index=True)
+    order = np.sort(first)
+    sides: list[PatchSide] = []
+    for value in values[order].tolist():
+        tface = abs(value)
+        if tface not in patch_ids:
+            raise builder.error(
+                f"REGION {region.name!r} refers to TFACE {tface}, which is not defined",
+                region.line,
+            )
+        side = 1 if value > 0 else -1
+        if matched.flipped.get(tface):
+            side = -side
+        sides.append(PatchSide(tface, side))  # type: ignore[arg-type]
+    if unique.shape[0] < values.shape[0]:
+        again = np.ones(values.shape[0], dtype=bool)
+        again[first] = False
+        builder.warn(
+            f"REGION {region.name!r} lists {values.shape[0] - unique.shape[0]} side(s) again "
+            f"(the first {int(values[np.argmax(again)]):+d}); each is kept once",
+            region.line,
+        )
+    return tuple(sides)
+
+
+def _region_blocks(
+    header: Model3dHeader, matched: _TFaceMatcher, first_id: int, builder: Diagnostics
+) -> tuple[list[Entity], dict[int, int]]:
+    """One block per REGION (sides as the key triangles say) and ``{REGION id: block id}``."""
+    patch_ids = {p.id for p in matched.patches}
+    layer_of: dict[int, str] = {}
+    for entry in header.lists:
+        if entry.keyword == "LAYER":
+            for region_id in entry.items:
+                layer_of.setdefault(region_id, entry.name)
+    n_tfaces = len(matched.patches)
+    blocks: list[Entity] = []
+    region_block: dict[int, int] = {}
+    for region in header.regions:
+        if region.id <= n_tfaces or region.id in region_block:
+            builder.warn(
+                f"REGION id {region.id} should follow the TFACE ids and be unique; "
+                "it is renumbered when written",
+                region.line,
+            )
+        sides = _region_sides(region, matched, patch_ids, builder)
+        block_id = first_id + len(blocks)
+        region_block[region.id] = block_id
+        universe = region.name.strip().lower() == "universe"
+        blocks.append(
+            Block(
+                id=block_id,
+                name=region.name,
+                kind=UNIVERSE_KIND if universe else "unit",
+                sides=sides,
+                unit_name=None if universe else layer_of.get(region.id),
+                metadata={"gocad": {"region_id": region.id}},
+            )
+        )
+    return blocks, region_block
+
+
+def _with_blocks(patches: list[Patch], blocks: list[Entity]) -> list[Patch]:
+    """The patches with the first block on each of their sides."""
+    positive: dict[int, int] = {}
+    negative: dict[int, int] = {}
+    for block in blocks:
+        assert isinstance(block, Block)
+        for patch_id, side in block.sides:
+            (positive if side == 1 else negative).setdefault(patch_id, int(block.id or 0))
+    return [
+        p.model_copy(
+            update={"positive_block": positive.get(p.id), "negative_block": negative.get(p.id)}
+        )
+        for p in patches
+    ]
+
+
+def _rebuilt_topology(
+    surfaces: list[Surface],
+    patches: list[Patch],
+    tolerance: float,
+    warn: Callable[[str], None] | None,
+) -> Topology:
+    """Corners and arcs rebuilt from the patches (BSTONEs as extra corners) around them."""
+    corners, arcs, patch_arcs = corners_and_arcs(
+        {int(s.id or 0): s for s in surfaces}, patches, tolerance, _bstone_points(surfaces)
+    )
+    if warn is not None:
+        warn_idle_bstones(surfaces, corners, tolerance, warn)
+    return Topology(
+        corners=tuple(corners),
+        arcs=tuple(arcs),
+        patches=tuple(
+            p.model_copy(update={"arcs": tuple(patch_arcs.get(p.id, ()))}) for p in patches
+        ),
+    )
+
+
+def _model_metadata(model: GocadObject) -> dict[str, Any]:
+    """What the scene keeps of the Model3d object (JSON, for the writer)."""
+    kept: dict[str, Any] = {
+        "version": model.version,
+        "header": [[k, v] for k, v in model.header],
+        "tsurfs": list(model.model3d.tsurfs),
+    }
+    if model.extra_lines:
+        kept["extra_lines"] = model.extra_lines
+    return {"gocad": {"model3d": kept}}
+
+
+def _orient_by_key_triangles(
+    surfaces: list[Surface],
+    key_faces: dict[int, dict[int, int | None]],
+    patches: list[Patch],
+    builder: Diagnostics,
+) -> list[Surface]:
+    """Each TFACE's triangles turned to agree with its key triangle (one warning per surface)."""
+    tface_of = {(p.surface, p.label): p.id for p in patches}
+    out: list[Surface] = []
+    for surface in surfaces:
+        sid = int(surface.id or 0)
+        oriented, flips = orient_patches(surface, key_faces.get(sid, {}))
+        if flips:
+            total = sum(flips.values())
+            where = ", ".join(
+                f"TFACE {tface_of.get((sid, label), label + 1)}: {count}"
+                for label, count in sorted(flips.items())
+            )
+            builder.warn(
+                f"surface {surface.name!r}: {total} triangle(s) flipped to agree with the key "
+                f"triangle of their TFACE ({where}); read with repair=False to keep them as written"
+            )
+        out.append(oriented)
+    return out
+
+
+def _groups(
+    lists: Sequence[ModelList],
+    region_block: dict[int, int],
+    patches: list[Patch],
+    builder: Diagnostics,
+) -> list[Group]:
+    surface_of_tface = {p.id: p.surface for p in patches}
+    groups: list[Group] = []
+    for entry in lists:
+        items = list(entry.items)
+        if entry.keyword in ("LAYER", "FAULT_BLOCK"):
+            unknown = [i for i in items if i not in region_block]
+            if unknown:
+                builder.warn(
+                    f"{entry.keyword} {entry.name!r}: id {unknown[0]} does not match a REGION",
+                    entry.line,
+                )
+            members = [region_block[i] for i in items if i in region_block]
+            # "unmatched": ids the file itself lists without a REGION (kept when written)
+            raw = {"keyword": entry.keyword, "regions": items, "unmatched": unknown}
+        else:
+            members = list(
+                dict.fromkeys(surface_of_tface[i] for i in items if i in surface_of_tface)
+            )
+            raw = {"keyword": entry.keyword, "tfaces": items}
+        groups.append(
+            Group(
+                name=entry.name,
+                kind=_LIST_KINDS[entry.keyword],
+                members=tuple(dict.fromkeys(members)),
+                metadata={"gocad": raw},
+            )
+        )
+    return groups
+
+
+def _bstone_points(surfaces: list[Surface]) -> NDArray[np.float64]:
+    points = []
+    for surface in surfaces:
+        gocad = gocad_section(surface.metadata)
+        if gocad.get("bstones"):
+            points.append(surface.vertices[np.asarray(gocad["bstones"], dtype=np.int64)])
+    return np.concatenate(points) if points else np.zeros((0, 3))
+
+
+def warn_idle_bstones(
+    surfaces: list[Surface],
+    corners: Sequence[Corner],
+    tolerance: float,
+    warn: Callable[[str], None],
+) -> None:
+    """One warning per surface whose BSTONEs mark no corner (not on a border of the model):
+    a writer then puts its BSTONEs at the corners, so they need not come back as they were."""
+    if not corners:
+        points = np.zeros((0, 3))
+    else:
+        points = np.array([c.point for c in corners], dtype=np.float64).reshape(-1, 3)
+    for surface in surfaces:
+        stones = gocad_section(surface.metadata).get("bstones") or []
+        if not stones:
+            continue
+        at = surface.vertices[np.asarray(stones, dtype=np.int64)]
+        if points.shape[0]:
+            gaps = np.abs(at[:, None, :] - points[None, :, :]).max(axis=2).min(axis=1)
+            idle = [int(v) for v, gap in zip(stones, gaps, strict=True) if gap > tolerance]
+        else:
+            idle = [int(v) for v in stones]
+        if idle:
+            warn(
+                f"surface {surface.name!r}: {len(idle)} BSTONE(s) not on a border of the model "
+                f"(vertex index {idle[0]}{', ...' if len(idle) > 1 else ''}) mark no corner"
+            )
+
+
+def border_topology(
+    surfaces: list[Surface],
+    options: GocadOptions,
+    warn: Callable[[str], None] | None = None,
+) -> Topology:
+    """Patches (one per TFACE) with corners from BSTONEs and arcs, for TSurfs outside a Model3d."""
+    patches = [
+        Patch(id=number, surface=int(s.id or 0), label=label, name=f"{s.name}:{label}")
+        for number, (s, label) in enumerate(
+            (s, label) for s in surfaces for label in range(s.n_patches)
+        )
+    ]
+    points = np.concatenate([s.vertices for s in surfaces if s.n_vertices] or [np.zeros((1, 3))])
+    diagonal = _box_diagonal(points)
+    return _rebuilt_topology(surfaces, patches, options.merge_tolerance_for(diagonal), warn)

@@ -1,0 +1,218 @@
+"""Write the built topology into a new scene: patch-labelled surfaces, corners, arcs, patches,
+blocks with their signed patch lists and attributes, and the universe.
+
+Each surface keeps its id, name, kind, metadata and properties; its faces become triangles (quads
+are split, their face properties repeated), dangling and collapsed faces are dropped, vertices
+merged with another surface take that vertex's coordinates, and ``patch_labels`` /
+``patch_names`` number its patches. Vertex order is kept where vertices survive.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep import Arc, Block, Corner, Entity, Group, Patch, PatchSide, Scene, Surface, Topology
+from geobrep.plugins import UNIVERSE_KIND
+from geobrep.plugins.blocks._arcs import ArcChains
+from geobrep.plugins.blocks._measures import PatchMeasures
+from geobrep.plugins.blocks._patches import PatchSplit
+from geobrep.plugins.blocks._radial_sort import SortedArcs
+from geobrep.plugins.blocks._soup import Soup
+from geobrep.plugins.blocks._units import block_attributes
+from geobrep.plugins.blocks._universe import Bodies
+
+__all__ = ["Assembly", "assemble"]
+
+IntArray = NDArray[np.int64]
+
+
+@dataclass(frozen=True)
+class Assembly:
+    scene: Scene
+    removed_surfaces: list[str]
+    internal_patches: list[int]
+    #: Soup vertex of every vertex of each rebuilt surface, by surface id.
+    vertex_ids: dict[int, IntArray]
+
+
+def _rebuilt_surface(soup: Soup, split: PatchSplit, index: int) -> tuple[Surface, IntArray] | None:
+    surface = soup.surfaces[index]
+    rows = np.flatnonzero(soup.triangle_surface == index)
+    if rows.size == 0:
+        return None
+    merged = soup.triangles[rows]
+    vertex_map = soup.vertex_maps[index]
+    # The first original vertex of each merged vertex stands for it; keep their order.
+    first = np.full(soup.vertices.shape[0], vertex_map.shape[0], dtype=np.int64)
+    np.minimum.at(first, vertex_map[::-1], np.arange(vertex_map.shape[0] - 1, -1, -1))
+    used = np.zeros(soup.vertices.shape[0], dtype=np.bool_)
+    used[merged.reshape(-1)] = True
+    kept = np.sort(first[used])
+    rank = np.empty(soup.vertices.shape[0], dtype=np.int64)
+    rank[vertex_map[kept]] = np.arange(kept.shape[0], dtype=np.int64)
+    labels = split.patch_label[split.triangle_patch[rows]]
+    n_labels = int(labels.max()) + 1
+    name = surface.name or f"surface {surface.id}"
+    ids = vertex_map[kept]
+    rebuilt = Surface(
+        id=surface.id,
+        name=surface.name,
+        kind=surface.kind,
+        metadata=surface.metadata,
+        vertices=soup.vertices[ids],
+        faces=rank[merged],
+        patch_labels=labels,
+        patch_names=tuple(f"{name}:{k}" for k in range(n_labels)),
+        point_data=surface.point_data.take(kept),
+        cell_data=surface.cell_data.take(soup.triangle_face[rows]),
+    )
+    return rebuilt, ids
+
+
+def assemble(
+    scene: Scene,
+    soup: Soup,
+    split: PatchSplit,
+    chains: ArcChains,
+    arcs: SortedArcs,
+    bodies: Bodies,
+    measures: PatchMeasures,
+) -> Assembly:
+    """The scene with the built topology (blocks and topology of ``scene`` are replaced)."""
+    built_ids = {int(s.id or 0) for s in soup.surfaces}
+    results = {
+        int(s.id or 0): _rebuilt_surface(soup, split, i) for i, s in enumerate(soup.surfaces)
+    }
+    surfaces = {key: None if found is None else found[0] for key, found in results.items()}
+    vertex_ids = {key: found[1] for key, found in results.items() if found is not None}
+    kept: list[Entity] = []
+    for entity in scene.entities:
+        if isinstance(entity, Block):
+            continue
+        if int(entity.id or 0) in built_ids and isinstance(entity, Surface):
+            rebuilt = surfaces[int(entity.id or 0)]
+            if rebuilt is not None:
+                kept.append(rebuilt)
+            continue
+        kept.append(entity)
+    removed = [
+        soup.surface_name(i)
+        for i, s in enumerate(soup.surfaces)
+        if surfaces[int(s.id or 0)] is None
+    ]
+
+    # Blocks: real bodies by decreasing centroid height, then the universe.
+    real = [b for b in range(bodies.n_bodies) if b != bodies.universe]
+    attributes = block_attributes(
+        soup, split, measures, bodies.positive, bodies.negative, bodies.volumes, real
+    )
+    real.sort(key=lambda b: (-attributes[b].centroid[2], attributes[b].centroid[0], b))
+    next_id = max((int(e.id or 0) for e in kept), default=-1) + 1
+    block_id = {body: next_id + k for k, body in enumerate(real)}
+    block_id[bodies.universe] = next_id + len(real)
+
+    sides: dict[int, list[PatchSide]] = {b: [] for b in block_id.values()}
+    for patch in range(split.n_patches):
+        sides[block_id[int(bodies.positive[patch])]].append(PatchSide(patch, 1))
+        sides[block_id[int(bodies.negative[patch])]].append(PatchSide(patch, -1))
+    blocks: list[Block] = []
+    for k, body in enumerate(real):
+        info = attributes[body]
+        metadata: dict[str, Any] = {
+            "volume": float(bodies.volumes[body]),
+            "centroid": list(info.centroid),
+            "top_horizons": list(info.tops),
+            "base_horizons": list(info.bases),
+            "faults": list(info.faults),
+        }
+        blocks.append(
+            Block(
+                id=block_id[body],
+                name=f"block {k + 1}",
+                unit_name=info.unit_name,
+                sides=tuple(sides[block_id[body]]),
+                metadata=metadata,
+            )
+        )
+    blocks.append(
+        Block(
+            id=block_id[bodies.universe],
+            name="universe",
+            kind=UNIVERSE_KIND,
+            sides=tuple(sides[block_id[bodies.universe]]),
+        )
+    )
+
+    topology = _topology(soup, split, chains, arcs, bodies, block_id)
+    groups = _groups(scene, {int(e.id or 0) for e in kept}, [int(b.id or 0) for b in blocks])
+    internal = [p.id for p in topology.patches if p.is_internal]
+    built = scene.replace(entities=(*kept, *blocks), topology=topology, groups=groups)
+    return Assembly(built, removed, internal, vertex_ids)
+
+
+def _topology(
+    soup: Soup,
+    split: PatchSplit,
+    chains: ArcChains,
+    arcs: SortedArcs,
+    bodies: Bodies,
+    block_id: dict[int, int],
+) -> Topology:
+    around = arcs.around
+    corners = tuple(
+        Corner(id=k, point=soup.vertices[v]) for k, v in enumerate(chains.corners.tolist())
+    )
+    patch_arcs: list[set[int]] = [set() for _ in range(split.n_patches)]
+    for arc, patch in zip(around.arc.tolist(), around.patch.tolist(), strict=True):
+        patch_arcs[patch].add(arc)
+    arc_list = []
+    for a in range(chains.n_arcs):
+        chain = chains.chain_vertices[chains.chain_offsets[a] : chains.chain_offsets[a + 1]]
+        members = around.patch[around.offsets[a] : around.offsets[a + 1]]
+        arc_list.append(
+            Arc(
+                id=a,
+                points=soup.vertices[chain],
+                start=int(chains.arc_start[a]),
+                end=int(chains.arc_end[a]),
+                patches=tuple(int(p) for p in members),
+            )
+        )
+    counts = split.patch_triangle_counts()
+    patches = []
+    for patch in range(split.n_patches):
+        index = int(split.patch_surface[patch])
+        surface = soup.surfaces[index]
+        label = int(split.patch_label[patch])
+        patches.append(
+            Patch(
+                id=patch,
+                surface=int(surface.id or 0),
+                label=label,
+                name=f"{surface.name or f'surface {surface.id}'}:{label}",
+                positive_block=block_id[int(bodies.positive[patch])],
+                negative_block=block_id[int(bodies.negative[patch])],
+                arcs=tuple(sorted(patch_arcs[patch])),
+                metadata={"triangles": int(counts[patch])},
+            )
+        )
+    return Topology(corners=corners, arcs=tuple(arc_list), patches=tuple(patches))
+
+
+def _groups(scene: Scene, entity_ids: set[int], block_ids: list[int]) -> tuple[Group, ...]:
+    """The scene's groups without members that are gone, plus a ``blocks`` group."""
+
+    def prune(group: Group) -> Group:
+        return group.model_copy(
+            update={
+                "members": tuple(m for m in group.members if m in entity_ids),
+                "children": tuple(prune(c) for c in group.children),
+            }
+        )
+
+    kept = tuple(prune(g) for g in scene.groups if g.name != "blocks")
+    return (*kept, Group(name="blocks", kind="blocks", members=tuple(block_ids)))

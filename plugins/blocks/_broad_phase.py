@@ -1,0 +1,271 @@
+"""Candidate pairs of triangles from different groups, by hashing into a uniform grid.
+
+Cells are one and a half median triangle extents wide. Each triangle's box (grown by the
+margin) is first entered in one cell only, the one holding its lower corner — or, when it
+spans more than two cells along an axis, in every cell it reaches. The lowest and the highest
+group entered in each cell, spread over its 3 x 3 x 3 neighbourhood, tell which boxes may meet
+a box of another group: most of a large surface lies far from the others and goes no further.
+
+The boxes left are entered in every cell they reach, and only cells that two groups reach are
+kept. A triangle larger than two median extents (a coarse boundary surface, a long fan
+triangle) has a box that covers — and would pair it with — every small triangle around it, so
+it is kept only in the cells it really comes near (no separating axis between the triangle and
+the cell grown by the margin). Rows are sorted by (cell, group); the partners of a row are the
+rows of its cell that belong to later groups, so pairs inside one group (triangles of one
+surface) are never generated. A pair of boxes is reported from one cell only, the one holding
+the lower corner of their overlap; only pairs involving a large triangle need deduplicating.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep.plugins.blocks._csr import concatenated_ranges
+
+__all__ = ["overlapping_pairs"]
+
+IntArray = NDArray[np.int64]
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+#: Triangles larger than this many median extents are kept only in the cells they come near.
+_LARGE_FACTOR = 2.0
+#: Grid cell size, in median extents, and the most cells along an axis.
+_CELL_FACTOR = 1.5
+_MAX_CELLS = 192
+#: Cell offsets (x, y, z) of the eight cells a box reaching two cells per axis may reach; code c
+#: has bit 4 set when the cell lies past the box's first cell along x, 2 along y, 1 along z.
+_OFFSETS = np.array([[(c >> 2) & 1, (c >> 1) & 1, c & 1] for c in range(8)], dtype=np.int64).T
+
+
+def _boxes(corners: FloatArray, margin: float) -> tuple[FloatArray, FloatArray]:
+    """Boxes of triangles stored component-major, (corner, xyz, K): mins and maxs (xyz, K)."""
+    a, b, c = corners[0], corners[1], corners[2]
+    return np.minimum(np.minimum(a, b), c) - margin, np.maximum(np.maximum(a, b), c) + margin
+
+
+def _dilated(values: NDArray[Any], op: Callable[..., object]) -> NDArray[Any]:
+    """``op`` (``np.minimum`` or ``np.maximum``) over the 3 x 3 x 3 cells around each cell."""
+    for axis in range(3):
+        moved = np.moveaxis(values, axis, 0)
+        out = moved.copy()
+        op(out[1:], moved[:-1], out=out[1:])
+        op(out[:-1], moved[1:], out=out[:-1])
+        values = np.moveaxis(out, 0, axis)
+    return values
+
+
+class _Grid:
+    """A dense uniform grid of cubic cells over the boxes (``origin`` is a column)."""
+
+    def __init__(self, origin: FloatArray, size: float, top: FloatArray) -> None:
+        self.origin, self.size = origin[:, None], size
+        self.dims = np.floor((top - origin) / size).astype(np.int64) + 1
+        self.strides = np.array([self.dims[1] * self.dims[2], self.dims[2], 1], dtype=np.int64)
+        self.n_cells = int(np.prod(self.dims))
+
+    def ranges(self, mins: FloatArray, maxs: FloatArray) -> tuple[IntArray, IntArray]:
+        """First cell (xyz, K) of each box and how many cells past it the box reaches."""
+        lo = np.floor((mins - self.origin) / self.size).astype(np.int64)
+        hi = np.floor((maxs - self.origin) / self.size).astype(np.int64)
+        np.maximum(lo, 0, out=lo)
+        np.minimum(hi, self.dims[:, None] - 1, out=hi)
+        hi -= lo
+        return lo, hi
+
+    def cells(self, first: IntArray, past: IntArray) -> tuple[IntArray, IntArray, IntArray]:
+        """Rows (box, cell key, offset code) of every cell of each box's range."""
+        sizes = past + 1
+        counts = sizes[0] * sizes[1] * sizes[2]
+        box = np.repeat(np.arange(counts.shape[0], dtype=np.int64), counts)
+        k = concatenated_ranges(np.zeros(counts.shape[0], np.int64), counts)
+        dx, rest = np.divmod(k, np.repeat(sizes[1] * sizes[2], counts))
+        dy, dz = np.divmod(rest, np.repeat(sizes[2], counts))
+        key = (self.strides @ first)[box] + dx * self.strides[0] + dy * self.strides[1] + dz
+        code = 4 * (dx > 0) + 2 * (dy > 0) + (dz > 0).astype(np.int64)
+        return box, key, code
+
+    def touches(self, corners: FloatArray, key: IntArray, margin: float) -> BoolArray:
+        """Whether each triangle (component-major, (corner, xyz, R)) comes within ``margin`` of
+        cell ``key``: no separating axis between it and the cell grown by ``margin`` among the
+        triangle's normal and its edges crossed with x, y and z (the cell's own axes separate
+        nothing: the triangle's box reaches the cell)."""
+        index = np.stack([key // self.strides[0], (key // self.strides[1]) % self.dims[1]])
+        index = np.concatenate([index, (key % self.dims[2])[None]])
+        half = 0.5 * self.size
+        p = corners - (index * self.size + (self.origin + half))  # corners about the centre
+        radius = (half + margin) * (1.0 + 1e-9)
+        edge = p[[1, 2, 0]] - p  # edge k runs from corner k to k + 1
+        normal = np.stack(
+            [
+                edge[0, 1] * edge[1, 2] - edge[0, 2] * edge[1, 1],
+                edge[0, 2] * edge[1, 0] - edge[0, 0] * edge[1, 2],
+                edge[0, 0] * edge[1, 1] - edge[0, 1] * edge[1, 0],
+            ]
+        )
+        near = np.abs((normal * p[0]).sum(axis=0)) <= radius * np.abs(normal).sum(axis=0)
+        for u in range(3):  # the axis edge x e_u has components e_w along v and -e_v along w
+            v, w = (u + 1) % 3, (u + 2) % 3
+            for k in range(3):
+                ev, ew = edge[k, v], edge[k, w]
+                # Corners k and k + 1 project alike; corner k + 2 is the other end.
+                one = p[k, v] * ew - p[k, w] * ev
+                other = p[(k + 2) % 3, v] * ew - p[(k + 2) % 3, w] * ev
+                reach = radius * (np.abs(ev) + np.abs(ew))
+                near &= (np.minimum(one, other) <= reach) & (np.maximum(one, other) >= -reach)
+        return np.asarray(near)
+
+
+def _near_other_groups(
+    grid: _Grid, first: IntArray, past: IntArray, groups: NDArray[np.integer]
+) -> tuple[BoolArray, IntArray, IntArray, IntArray, IntArray]:
+    """Which boxes may meet a box of another group, and the rows of the spread boxes (those
+    reaching more than two cells along an axis): box, cell key, offset code.
+
+    A box reaching at most two cells per axis is entered in its first cell only: a box it
+    overlaps has entered a cell of the 3 x 3 x 3 around that one."""
+    lower = grid.strides @ first
+    spread = np.flatnonzero((past > 1).any(axis=0))
+    box, key, code = grid.cells(first[:, spread], past[:, spread])
+    box = spread[box]
+    lowest = np.full(grid.n_cells, np.iinfo(groups.dtype).max, dtype=groups.dtype)
+    highest = np.zeros(grid.n_cells, dtype=groups.dtype)
+    for where, group in ((lower, groups), (key, groups[box])):
+        np.minimum.at(lowest, where, group)
+        np.maximum.at(highest, where, group)
+    dims = tuple(grid.dims.tolist())
+    mixed = (
+        _dilated(lowest.reshape(dims), np.minimum) < _dilated(highest.reshape(dims), np.maximum)
+    ).reshape(-1)
+    near = mixed[lower]
+    near[spread] = False
+    near[box[mixed[key]]] = True
+    return near, spread, box, key, code
+
+
+def overlapping_pairs(
+    corners: FloatArray, groups: IntArray, margin: float = 0.0, cell: float | None = None
+) -> tuple[IntArray, IntArray]:
+    """Pairs ``(i, j)``, ``groups[i] < groups[j]``, of triangles ``corners`` (K, 3, 3) that may
+    lie within ``margin`` of each other: their boxes, grown by ``margin``, overlap, and a
+    triangle larger than two median extents (or than ``cell`` · 4/3) comes within ``margin`` of
+    a grid cell the other's box reaches. Every pair closer than ``margin`` is listed.
+
+    A point is a triangle with three equal corners. Each pair is listed once, in no set order.
+    ``cell`` is the grid cell size (default 1.5 median triangle extents).
+
+    >>> import numpy as np
+    >>> flat = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]
+    >>> corners = np.array([flat, np.add(flat, [0.5, 0.5, 0]), np.add(flat, 3.0)], dtype=float)
+    >>> i, j = overlapping_pairs(corners, np.array([0, 1, 1]))
+    >>> i.tolist(), j.tolist()
+    ([0], [1])
+    """
+    n = corners.shape[0]
+    empty = np.zeros(0, dtype=np.int64)
+    if n == 0:
+        return empty, empty
+    stored = np.ascontiguousarray(np.transpose(corners, (1, 2, 0)), dtype=np.float64)
+    mins, maxs = _boxes(stored, margin)
+    size = maxs - mins
+    extent = np.maximum(np.maximum(size[0], size[1]), size[2])  # margins included
+    if cell is None:
+        cell = _CELL_FACTOR * float(np.median(extent - 2.0 * margin))
+    origin, top = mins.min(axis=1), maxs.max(axis=1)
+    span = float((top - origin).max())
+    cell = max(cell, 3.0 * margin, span / _MAX_CELLS, span / 2.0**20, np.finfo(np.float64).tiny)
+    grid = _Grid(origin, cell, top)
+    shifted = np.asarray(groups) - int(np.min(groups))
+    table = shifted.astype(np.min_scalar_type(int(shifted.max())))
+    first, past = grid.ranges(mins, maxs)
+    near, spread, s_box, s_key, s_code = _near_other_groups(grid, first, past, table)
+    # Rows of the boxes left: those reaching at most two cells per axis from the offsets table.
+    is_spread = np.zeros(n, dtype=np.bool_)
+    is_spread[spread] = True
+    compact = np.flatnonzero(near & ~is_spread)
+    reached = (
+        (_OFFSETS[0][:, None] <= past[0, compact])
+        & (_OFFSETS[1][:, None] <= past[1, compact])
+        & (_OFFSETS[2][:, None] <= past[2, compact])
+    )
+    code, which = np.nonzero(reached)
+    box = compact[which]
+    key = (grid.strides @ first[:, compact])[which] + (grid.strides @ _OFFSETS)[code]
+    kept = near[s_box]
+    box = np.concatenate([box, s_box[kept]])
+    key = np.concatenate([key, s_key[kept]])
+    code = np.concatenate([code.astype(np.int64), s_code[kept]])
+    # Only cells that two groups reach.
+    group = table[box]
+    lowest = np.full(grid.n_cells, np.iinfo(table.dtype).max, dtype=table.dtype)
+    highest = np.zeros(grid.n_cells, dtype=table.dtype)
+    np.minimum.at(lowest, key, group)
+    np.maximum.at(highest, key, group)
+    live = lowest[key] < highest[key]
+    box, key, code = box[live], key[live], code[live]
+    # Large triangles: only the cells they come near; their pairs are deduplicated instead.
+    large = extent > cell * (_LARGE_FACTOR / _CELL_FACTOR) + 2.0 * margin
+    rows = np.flatnonzero(large[box])
+    if rows.size:
+        touching = grid.touches(stored[:, :, box[rows]], key[rows], margin)
+        code[rows] = 0
+        keep = np.ones(box.shape[0], dtype=np.bool_)
+        keep[rows[~touching]] = False
+        box, key, code = box[keep], key[keep], code[keep]
+    if box.size == 0:
+        return empty, empty
+    return _cell_pairs(box, key, code, shifted, mins, maxs, large)
+
+
+def _cell_pairs(
+    box: IntArray,
+    key: IntArray,
+    code: IntArray,
+    groups: IntArray,
+    mins: FloatArray,
+    maxs: FloatArray,
+    large: BoolArray,
+) -> tuple[IntArray, IntArray]:
+    """Pairs of boxes of different groups sharing a cell, from rows (box, cell key, code)."""
+    n = groups.shape[0]
+    n_groups = int(groups.max()) + 1
+    group = groups[box]
+    if (int(key.max()) + 1) * n_groups < (2**62) // (8 * n):
+        packed = np.sort(((key * n_groups + group) * n + box) * 8 + code)
+        code = packed & 7
+        packed >>= 3
+        box = packed % n
+        packed //= n
+        group, key = packed % n_groups, packed // n_groups
+    else:
+        order = np.lexsort((box, group, key))
+        key, box, code, group = key[order], box[order], code[order], group[order]
+    n_rows = key.shape[0]
+    new_cell = np.ones(n_rows, dtype=np.bool_)
+    new_cell[1:] = key[1:] != key[:-1]
+    new_block = new_cell.copy()
+    new_block[1:] |= group[1:] != group[:-1]
+    cell_end = np.append(np.flatnonzero(new_cell)[1:], n_rows)[np.cumsum(new_cell) - 1]
+    block_end = np.append(np.flatnonzero(new_block)[1:], n_rows)[np.cumsum(new_block) - 1]
+    partners = cell_end - block_end
+    first_row = np.repeat(np.arange(n_rows, dtype=np.int64), partners)
+    second_row = concatenated_ranges(block_end, partners)
+    # The cell is the lower corner of the boxes' overlap unless both reached it by stepping up
+    # along some axis (their offset codes share a bit).
+    canonical = np.flatnonzero((code[first_row] & code[second_row]) == 0)
+    first, second = box[first_row[canonical]], box[second_row[canonical]]
+    keep = (mins[0, first] <= maxs[0, second]) & (mins[0, second] <= maxs[0, first])
+    for k in (1, 2):
+        keep &= (mins[k, first] <= maxs[k, second]) & (mins[k, second] <= maxs[k, first])
+    first, second = first[keep], second[keep]
+    once = ~(large[first] | large[second])
+    i, j = first[once], second[once]
+    if not once.all():
+        unique = np.unique(first[~once] * n + second[~once])
+        i = np.concatenate([i, unique // n])
+        j = np.concatenate([j, unique % n])
+    return i.astype(np.int64), j.astype(np.int64)

@@ -1,0 +1,63 @@
+"""Per-patch sums over triangles, in one pass: signed-volume share, first moment, vector area.
+
+Coordinates are taken relative to the model centre, so UTM-scale models keep full precision.
+For a block, summing ``−side ×`` these over its patch sides gives its volume and centroid; the
+vector area tells which way a horizon patch faces.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep.plugins.blocks._csr import group_sums
+from geobrep.plugins.blocks._patches import PatchSplit
+from geobrep.plugins.blocks._soup import Soup
+
+__all__ = ["PatchMeasures", "measure_patches"]
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class PatchMeasures:
+    """``volume[p] = Σ a·(b×c)/6``, ``moment[p] = Σ (a+b+c)/4 · a·(b×c)/6``, ``area[p] = Σ
+    (b−a)×(c−a)/2`` over the triangles ``(a, b, c)`` of patch ``p`` (model-centred)."""
+
+    volume: FloatArray
+    moment: FloatArray
+    area: FloatArray
+
+
+def _cross(u: FloatArray, v: FloatArray) -> FloatArray:
+    """Cross products of (3, M) column vectors."""
+    return np.stack(
+        [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+    )
+
+
+def measure_patches(soup: Soup, split: PatchSplit) -> PatchMeasures:
+    """The sums for every patch of ``split``.
+
+    >>> import geobrep
+    >>> from geobrep.plugins.blocks._soup import build_soup
+    >>> from geobrep.plugins.blocks._patches import split_patches
+    >>> scene = geobrep.datasets.faulted_layer_cake()
+    >>> soup = build_soup(scene.surfaces, None, 1e-7)
+    >>> measures = measure_patches(soup, split_patches(soup))
+    >>> measures.volume.shape, measures.moment.shape, measures.area.shape
+    ((31,), (31, 3), (31, 3))
+    """
+    columns = np.ascontiguousarray(soup.local(soup.vertices).T)
+    a, b, c = (np.take(columns, soup.triangles[:, k], axis=1) for k in range(3))
+    share = np.einsum("ij,ij->j", a, _cross(b, c)) / 6.0
+    moment = (a + b + c) * (share / 4.0)
+    area = 0.5 * _cross(b - a, c - a)
+    label, n = split.triangle_patch, split.n_patches
+    return PatchMeasures(
+        volume=group_sums(label, share, n),
+        moment=group_sums(label, moment.T, n),
+        area=group_sums(label, area.T, n),
+    )
