@@ -26,13 +26,13 @@ from scipy.interpolate import NdBSpline, RBFInterpolator
 
 from geobrep import NurbsSurface
 from geobrep.datasets import dome_elevation
-from geobrep.plugins.fit.approximation import approximate_points
+from geobrep.plugins.fit._approximation import approximate_points
+from geobrep.plugins.fit._frame import LocalFrame
+from geobrep.plugins.fit._knots import uniform_knots
+from geobrep.plugins.fit._variogram import Variogram
 from geobrep.plugins.fit.distance import surface_distances
-from geobrep.plugins.fit.frame import LocalFrame
-from geobrep.plugins.fit.knots import uniform_knots
 from geobrep.plugins.fit.kriging import krige
 from geobrep.plugins.fit.options import ApproximationOptions
-from geobrep.plugins.fit.variogram import Variogram
 
 QUICK = "--quick" in sys.argv
 UTM = np.array([450_000.0, 6_700_000.0, 0.0])

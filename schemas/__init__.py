@@ -24,7 +24,7 @@ SCHEMA_NAMES = ("scene", "pipeline")
 
 def generate() -> dict[str, dict[str, Any]]:
     """Build every schema from the current models."""
-    from geobrep.adapters.native.container import NativeDocument
+    from geobrep.adapters.native._container import NativeDocument
     from geobrep.batch.pipeline import Pipeline
 
     schemas = {
