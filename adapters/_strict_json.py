@@ -17,9 +17,10 @@ ValueError: NaN is not JSON (write it as the string "NaN")
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from typing import Any, NoReturn
 
-__all__ = ["loads"]
+__all__ = ["find_leaf", "loads"]
 
 
 def _refuse(constant: str) -> NoReturn:
@@ -33,3 +34,23 @@ def loads(text: str | bytes) -> Any:
         return json.loads(text, parse_constant=_refuse)
     except RecursionError:
         raise ValueError("JSON nested too deeply") from None
+
+
+def find_leaf(
+    data: Any, wanted: Callable[[Any, tuple[str, ...]], bool], where: tuple[str, ...] = ()
+) -> tuple[str, ...] | None:
+    """The path of the first leaf of a JSON document for which ``wanted(value, path)`` holds.
+
+    >>> find_leaf({"a": [1, float("nan")]}, lambda value, _: value != value)
+    ('a', '1')
+    >>> find_leaf({"a": 1}, lambda value, _: False) is None
+    True
+    """
+    if isinstance(data, dict | list):
+        items = data.items() if isinstance(data, dict) else enumerate(data)
+        for key, value in items:
+            found = find_leaf(value, wanted, (*where, str(key)))
+            if found is not None:
+                return found
+        return None
+    return where if wanted(data, where) else None

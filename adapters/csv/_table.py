@@ -12,6 +12,7 @@ import numpy as np
 import orjson
 from numpy.typing import NDArray
 
+from geobrep.adapters import _strict_json as strict_json
 from geobrep.adapters.casting import misfit_rows
 from geobrep.errors import FileAccessError, FormatError, GeobrepError
 from geobrep.model.crs import CRS
@@ -61,27 +62,19 @@ class _Constant(str):
     """``NaN``, ``Infinity`` or ``-Infinity`` as a metadata line spelled it (not JSON)."""
 
 
-def _misplaced_constant(data: Any, where: tuple[str, ...] = ()) -> str | None:
+def _misplaced_constant(data: Any) -> str | None:
     """Where ``data`` holds a :class:`_Constant` other than a property's no-data value.
 
     Older geobrep wrote NaN no-data values as bare ``NaN``: those are read; anywhere else a
     NaN would make the scene unwritable to JSON later.
     """
-    if isinstance(data, _Constant):
-        allowed = len(where) == 3 and where[0] == "properties" and where[2] == "no_data_value"
-        return None if allowed else ".".join(where) or "(the line)"
-    items = (
-        data.items()
-        if isinstance(data, dict)
-        else enumerate(data)
-        if isinstance(data, list)
-        else ()
-    )
-    for key, value in items:
-        found = _misplaced_constant(value, (*where, str(key)))
-        if found is not None:
-            return found
-    return None
+
+    def misplaced(value: Any, where: tuple[str, ...]) -> bool:
+        no_data = len(where) == 3 and where[0] == "properties" and where[2] == "no_data_value"
+        return isinstance(value, _Constant) and not no_data
+
+    found = strict_json.find_leaf(data, misplaced)
+    return None if found is None else ".".join(found) or "(the line)"
 
 
 def _metadata(line: str, path: Path, number: int) -> dict[str, Any]:

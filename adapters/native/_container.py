@@ -86,22 +86,14 @@ def _write_container(scene: Scene, path: Path, compress: bool) -> None:
                 np.lib.format.write_array(member, np.ascontiguousarray(array), allow_pickle=False)
 
 
-def _non_finite_at(data: Any, where: str = "") -> str | None:
+def _non_finite_at(data: Any) -> str | None:
     """The JSON path of the first NaN or infinity in ``data`` (None when there is none)."""
-    if isinstance(data, float) and not math.isfinite(data):
-        return where or "(the document)"
-    items = (
-        data.items()
-        if isinstance(data, dict)
-        else enumerate(data)
-        if isinstance(data, list)
-        else ()
-    )
-    for key, value in items:
-        found = _non_finite_at(value, f"{where}.{key}" if where else str(key))
-        if found is not None:
-            return found
-    return None
+
+    def non_finite(value: Any, _: tuple[str, ...]) -> bool:
+        return isinstance(value, float) and not math.isfinite(value)
+
+    found = strict_json.find_leaf(data, non_finite)
+    return None if found is None else ".".join(found) or "(the document)"
 
 
 def _document_text(document: dict[str, Any], path: Path) -> str:

@@ -14,9 +14,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.plugins import ArcChains, chain_arc_edges
-from geobrep.plugins.blocks._patches import PatchSplit
+from geobrep.plugins.blocks._patches import PatchSplit, split_patches
+from geobrep.plugins.blocks._soup import Soup, build_soup
 
-__all__ = ["ArcChains", "chain_arcs"]
+__all__ = ["ArcChains", "chain_arcs", "sample_model_arcs"]
 
 
 def chain_arcs(
@@ -43,3 +44,17 @@ def chain_arcs(
         n_vertices,
         vertices,
     )
+
+
+def sample_model_arcs() -> tuple[Soup, PatchSplit, ArcChains]:
+    """The built-in sample model as a soup, its patches and its arcs (the docstrings' example).
+
+    >>> soup, split, chains = sample_model_arcs()
+    >>> split.n_patches > 0, chains.n_arcs
+    (True, 52)
+    """
+    import geobrep
+
+    soup = build_soup(geobrep.datasets.faulted_layer_cake().surfaces, None, 1e-7)
+    split = split_patches(soup)
+    return soup, split, chain_arcs(split, soup.vertices.shape[0])

@@ -49,13 +49,9 @@ def free_border_arcs(split: PatchSplit, chains: ArcChains) -> IntArray:
 def free_border_patches(split: PatchSplit, chains: ArcChains) -> IntArray:
     """Patches with at least one free border.
 
-    >>> import geobrep
-    >>> from geobrep.plugins.blocks._arcs import chain_arcs
-    >>> from geobrep.plugins.blocks._patches import split_patches
-    >>> from geobrep.plugins.blocks._soup import build_soup
-    >>> soup = build_soup(geobrep.datasets.faulted_layer_cake().surfaces, None, 1e-7)
-    >>> split = split_patches(soup)
-    >>> free_border_patches(split, chain_arcs(split, soup.vertices.shape[0])).tolist()  # sealed
+    >>> from geobrep.plugins.blocks._arcs import sample_model_arcs
+    >>> soup, split, chains = sample_model_arcs()
+    >>> free_border_patches(split, chains).tolist()  # sealed
     []"""
     arcs = free_border_arcs(split, chains)
     edges = chains.edge_ids[chains.arc_offsets[arcs]]

@@ -80,13 +80,8 @@ def direction_triangles(
 
     Each position makes one group; the arc of a group is the arc holding that edge.
 
-    >>> import geobrep
-    >>> from geobrep.plugins.blocks._arcs import chain_arcs
-    >>> from geobrep.plugins.blocks._patches import split_patches
-    >>> from geobrep.plugins.blocks._soup import build_soup
-    >>> soup = build_soup(geobrep.datasets.faulted_layer_cake().surfaces, None, 1e-7)
-    >>> split = split_patches(soup)
-    >>> chains = chain_arcs(split, soup.vertices.shape[0])
+    >>> from geobrep.plugins.blocks._arcs import sample_model_arcs
+    >>> soup, split, chains = sample_model_arcs()
     >>> first = direction_triangles(soup.triangles, split, chains, chains.arc_offsets[:-1])
     >>> first.n_groups, first.triangle.shape[0]
     (52, 132)

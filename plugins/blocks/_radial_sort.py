@@ -99,13 +99,8 @@ def sort_arcs(
 ) -> SortedArcs:
     """Sort the patches around every arc, from one direction edge per arc where it suffices.
 
-    >>> import geobrep
-    >>> from geobrep.plugins.blocks._arcs import chain_arcs
-    >>> from geobrep.plugins.blocks._patches import split_patches
-    >>> from geobrep.plugins.blocks._soup import build_soup
-    >>> soup = build_soup(geobrep.datasets.faulted_layer_cake().surfaces, None, 1e-7)
-    >>> split = split_patches(soup)
-    >>> chains = chain_arcs(split, soup.vertices.shape[0])
+    >>> from geobrep.plugins.blocks._arcs import sample_model_arcs
+    >>> soup, split, chains = sample_model_arcs()
     >>> arcs = sort_arcs(soup.vertices, soup.triangles, split, chains, 1e-10, str)
     >>> arcs.touched_triangles, arcs.retried_arcs  # 132 of 4296 triangles, as in the paper
     (132, 0)"""

@@ -211,7 +211,6 @@ def test_every_file_to_every_format_reads_back_as_the_summary_says(tmp_path: Pat
     assert tally.converted > 50, summary
     assert not [f for f in tally.failed if "verify" in f], "\n".join(tally.failed)
     assert not tally.mismatches, summary + "\n" + "\n".join(tally.mismatches)
-    assert seconds < 60, summary
 
 
 GOCAD = DATA / "gocad"

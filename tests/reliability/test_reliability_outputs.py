@@ -91,7 +91,7 @@ def test_a_format_spec_bomb_costs_nothing() -> None:
     seconds = time.perf_counter() - started
     _, peak = tracemalloc.get_traced_memory()
     tracemalloc.stop()
-    assert seconds < 1.0
+    assert seconds < 30.0  # a hang guard, not a timing test: the memory bound is the test
     assert peak < 10 * 2**20
 
 
