@@ -96,9 +96,17 @@ if TYPE_CHECKING:
         FitResult,
         fit,
     )
+    from geobrep.ops.inspection import (
+        InspectionReport,
+        inspect,
+    )
     from geobrep.ops.io import (
         read,
         write,
+    )
+    from geobrep.ops.repairing import (
+        RepairReport,
+        repair,
     )
     from geobrep.ops.voxelization import (
         VoxelizationWarning,
@@ -126,6 +134,7 @@ __all__ = [
     "FormatError",
     "GeobrepError",
     "Group",
+    "InspectionReport",
     "LinearOctree",
     "MissingDependencyError",
     "NurbsSurface",
@@ -140,6 +149,7 @@ __all__ = [
     "PolyLine",
     "Polygon",
     "Property",
+    "RepairReport",
     "Scene",
     "Surface",
     "TetMesh",
@@ -155,9 +165,11 @@ __all__ = [
     "datasets",
     "fit",
     "from_geodataframe",
+    "inspect",
     "map_products",
     "plugins",
     "read",
+    "repair",
     "run_pipeline",
     "section",
     "to_geodataframe",
@@ -181,6 +193,8 @@ _LAZY_NAMES = {
     "FitReport": "geobrep.ops.fitting",
     "FitResult": "geobrep.ops.fitting",
     "Group": "geobrep.model.scene",
+    "InspectionReport": "geobrep.ops.inspection",
+    "RepairReport": "geobrep.ops.repairing",
     "LinearOctree": "geobrep.model.entities",
     "NurbsSurface": "geobrep.model.entities",
     "Patch": "geobrep.model.topology",
@@ -203,6 +217,8 @@ _LAZY_NAMES = {
     "convert": "geobrep.batch.conversion",
     "fit": "geobrep.ops.fitting",
     "from_geodataframe": "geobrep.gis.crs_ops",
+    "inspect": "geobrep.ops.inspection",
+    "repair": "geobrep.ops.repairing",
     "map_products": "geobrep.gis.map_products",
     "read": "geobrep.ops.io",
     "run_pipeline": "geobrep.batch.pipeline_run",

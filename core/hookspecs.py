@@ -24,6 +24,7 @@ import pluggy
 if TYPE_CHECKING:
     from geobrep.host.registry import (
         BuilderRegistry,
+        CheckRegistry,
         ClipperRegistry,
         FitterRegistry,
         FormatRegistry,
@@ -109,5 +110,19 @@ class GeobrepSpecs:
             def geobrep_register_voxelizers(registry):
                 registry.add(VoxelizerSpec(
                     name="octree", function=voxelize_scene, options=VoxelizeOptions,
+                ))
+        """
+
+    @hookspec
+    def geobrep_register_checks(self, registry: CheckRegistry) -> None:
+        """Register inspection criteria: :class:`~geobrep.plugins.CheckSpec` items, each finding
+        one kind of defect for :func:`geobrep.inspect` and ``geobrep check``.
+
+        Example::
+
+            @hookimpl
+            def geobrep_register_checks(registry):
+                registry.add(CheckSpec(
+                    name="mesh.long_edges", function=find_long_edges, options=LongEdgeOptions,
                 ))
         """

@@ -16,9 +16,9 @@ and implementing any of the hooks of :mod:`geobrep.hookspecs`::
 
 Everything a plugin needs is importable from here: the :data:`hookimpl` marker, the spec and
 registry types (``FormatSpec``, ``ClipperSpec``, ``FitterSpec``, ``BuilderSpec``,
-``VoxelizerSpec``, ...) and the Protocols their callables follow (``Reader``, ``Writer``,
-``ClipFunction``, ``FitFunction``, ...), the clipping context (``ClipContext``, ``SceneDraft``,
-``halves``, ``pack_halves``), the fit result types (``FitResult``, ``FitReport``),
+``VoxelizerSpec``, ``CheckSpec``, ...) and the Protocols their callables follow (``Reader``,
+``Writer``, ``ClipFunction``, ``FitFunction``, ...), the clipping context (``ClipContext``,
+``SceneDraft``, ``halves``, ``pack_halves``), the fit result types (``FitResult``, ``FitReport``),
 ``atomic_write``, the topology helpers (``chain_arc_edges``, ``build_corners_and_arcs``) and the
 errors. The model
 itself (``Scene``, ``Surface``, ``Plane``, ...) comes from :mod:`geobrep`, the kernels from
@@ -60,6 +60,9 @@ if TYPE_CHECKING:
         BuilderRegistry,
         BuilderSpec,
         BuildFunction,
+        CheckFunction,
+        CheckRegistry,
+        CheckSpec,
         ClipFunction,
         ClipperRegistry,
         ClipperSpec,
@@ -104,6 +107,10 @@ if TYPE_CHECKING:
         FitResult,
         SubsetReport,
     )
+    from geobrep.ops.inspection import (
+        CheckContext,
+        Defect,
+    )
     from geobrep.ops.io import (
         atomic_write,
     )
@@ -115,10 +122,15 @@ __all__ = [
     "BuildFunction",
     "BuilderRegistry",
     "BuilderSpec",
+    "CheckContext",
+    "CheckFunction",
+    "CheckRegistry",
+    "CheckSpec",
     "ClipContext",
     "ClipFunction",
     "ClipperRegistry",
     "ClipperSpec",
+    "Defect",
     "DegenerateGeometryError",
     "Deviation",
     "EntityNotFoundError",
@@ -174,6 +186,11 @@ _LAZY = {
     "BuilderSpec": "geobrep.host.registry",
     "ClipperRegistry": "geobrep.host.registry",
     "ClipperSpec": "geobrep.host.registry",
+    "CheckRegistry": "geobrep.host.registry",
+    "CheckSpec": "geobrep.host.registry",
+    "CheckFunction": "geobrep.host.registry",
+    "CheckContext": "geobrep.ops.inspection",
+    "Defect": "geobrep.ops.inspection",
     "FitterRegistry": "geobrep.host.registry",
     "FitterSpec": "geobrep.host.registry",
     "FormatCapabilities": "geobrep.host.registry",

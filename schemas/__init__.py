@@ -1,7 +1,8 @@
 """JSON Schemas generated from geobrep's pydantic models, and a loader.
 
 ``scene.schema.json`` describes ``scene.json``, the document inside a native ``.geobrep`` file;
-``pipeline.schema.json`` describes pipeline files (``geobrep run pipeline.yaml``).
+``pipeline.schema.json`` describes pipeline files (``geobrep run pipeline.yaml``);
+``inspection.schema.json`` describes an inspection report (``geobrep check --json``).
 Regenerate after changing a model with ``make schemas`` (``python -m geobrep.schemas``); a test
 fails when the stored file is stale.
 
@@ -19,18 +20,21 @@ from typing import Any
 
 __all__ = ["SCHEMA_NAMES", "generate", "load", "write_all"]
 
-SCHEMA_NAMES = ("scene", "pipeline")
+SCHEMA_NAMES = ("scene", "pipeline", "inspection")
 
 
 def generate() -> dict[str, dict[str, Any]]:
     """Build every schema from the current models."""
     from geobrep.adapters.native._container import NativeDocument
     from geobrep.batch.pipeline import Pipeline
+    from geobrep.ops.inspection import InspectionReport
 
     schemas = {
         "scene": NativeDocument.model_json_schema(mode="serialization"),
         "pipeline": Pipeline.model_json_schema(mode="validation", by_alias=True),
+        "inspection": InspectionReport.model_json_schema(mode="serialization"),
     }
+    schemas["inspection"]["title"] = "geobrep inspection report"
     for name, schema in schemas.items():
         schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
         schema["$id"] = f"https://geobrep.org/schemas/{name}.schema.json"

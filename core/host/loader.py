@@ -76,6 +76,7 @@ HOOK_KINDS: dict[str, str] = {
     "geobrep_register_fitters": "fitters",
     "geobrep_register_builders": "builders",
     "geobrep_register_voxelizers": "voxelizers",
+    "geobrep_register_checks": "checks",
 }
 """Each hook and the :class:`~geobrep.host.registry.Registries` field it fills."""
 

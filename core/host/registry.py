@@ -51,6 +51,9 @@ __all__ = [
     "BuildFunction",
     "BuilderRegistry",
     "BuilderSpec",
+    "CheckFunction",
+    "CheckRegistry",
+    "CheckSpec",
     "ClipFunction",
     "ClipperRegistry",
     "ClipperSpec",
@@ -153,6 +156,16 @@ class VoxelizeFunction(Protocol):
     """``function(scene, options) -> LinearOctree`` of the scene's closed bodies."""
 
     def __call__(self, scene: Scene, options: Any, /) -> LinearOctree: ...
+
+
+@runtime_checkable
+class CheckFunction(Protocol):
+    """``function(scene, options, context) -> [Defect, ...]``: the defects one criterion finds.
+
+    ``context`` is a :class:`geobrep.ops.inspection.CheckContext` (the tolerance asked for, and
+    a cache shared by the checks of one inspection)."""
+
+    def __call__(self, scene: Scene, options: Any, context: Any, /) -> list[Any]: ...
 
 
 class GeobrepPluginWarning(UserWarning):
@@ -459,6 +472,27 @@ class VoxelizerSpec(RegisteredItem):
     kind: ClassVar[str] = "voxelizer"
 
     function: VoxelizeFunction
+
+
+class CheckSpec(RegisteredItem):
+    """One inspection criterion: ``function(scene, options, context) -> [Defect, ...]``.
+
+    ``title`` is the section heading in a report; ``default`` says whether
+    :func:`geobrep.inspect` runs it when no ``checks`` are named; ``repairs`` names the
+    :func:`geobrep.repair` action that mends what it finds, if any.
+
+    Example:
+        >>> CheckSpec(name="mesh.isolated_vertices", function=lambda s, o, c: []).kind
+        'check'
+    """
+
+    kind: ClassVar[str] = "check"
+
+    function: CheckFunction
+    title: str = ""
+    family: str = ""
+    default: bool = True
+    repairs: str | None = None
 
 
 T = TypeVar("T", bound=RegisteredItem)
@@ -798,6 +832,12 @@ class VoxelizerRegistry(Registry[VoxelizerSpec]):
     item_type: ClassVar[type[RegisteredItem]] = VoxelizerSpec
 
 
+class CheckRegistry(Registry[CheckSpec]):
+    """Inspection criteria (:func:`geobrep.inspect`, ``geobrep check``)."""
+
+    item_type: ClassVar[type[RegisteredItem]] = CheckSpec
+
+
 @dataclass(frozen=True)
 class Registries:
     """The registries, one per hook kind.
@@ -812,8 +852,16 @@ class Registries:
     fitters: FitterRegistry = field(default_factory=FitterRegistry)
     builders: BuilderRegistry = field(default_factory=BuilderRegistry)
     voxelizers: VoxelizerRegistry = field(default_factory=VoxelizerRegistry)
+    checks: CheckRegistry = field(default_factory=CheckRegistry)
 
-    KINDS: ClassVar[tuple[str, ...]] = ("formats", "clippers", "fitters", "builders", "voxelizers")
+    KINDS: ClassVar[tuple[str, ...]] = (
+        "formats",
+        "clippers",
+        "fitters",
+        "builders",
+        "voxelizers",
+        "checks",
+    )
 
     @classmethod
     def staging(cls, plugin: str, *, builtin: bool = False) -> Registries:
@@ -824,6 +872,7 @@ class Registries:
             fitters=FitterRegistry(plugin=plugin, builtin=builtin),
             builders=BuilderRegistry(plugin=plugin, builtin=builtin),
             voxelizers=VoxelizerRegistry(plugin=plugin, builtin=builtin),
+            checks=CheckRegistry(plugin=plugin, builtin=builtin),
         )
 
     def by_kind(self) -> dict[str, Registry[Any]]:

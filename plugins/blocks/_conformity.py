@@ -35,6 +35,7 @@ __all__ = [
     "NonConformalError",
     "NonConformity",
     "check_conformity",
+    "find_defects",
     "point_triangle_distance",
     "separated",
     "triangles_intersect",
@@ -61,6 +62,10 @@ class NonConformity:
     surfaces: tuple[str, str]
     point: tuple[float, float, float]
     distance: float
+    triangles: tuple[int, int] = (-1, -1)
+    """The soup triangles involved (-1: none; a gap's first is its border vertex's)."""
+    vertex: int = -1
+    """The soup vertex of a gap or border T-junction (-1: none)."""
 
 
 class NonConformalError(TopologyError):
@@ -438,6 +443,7 @@ def _crossings(soup: Soup, tol: float) -> list[NonConformity]:
             surfaces=(soup.surface_name(int(surface[a])), soup.surface_name(int(surface[b]))),
             point=(float(m[0]), float(m[1]), float(m[2])),
             distance=float(d),
+            triangles=(a, b),
         )
         for a, b, d, m in zip(i.tolist(), j.tolist(), touch.tolist(), middle, strict=True)
     ]
@@ -504,6 +510,8 @@ def _gaps(soup: Soup, split: PatchSplit, gap_tolerance: float, tol: float) -> li
                 ),
                 point=(x, y, z),
                 distance=float(distance[k]),
+                triangles=(-1, int(t[k])),
+                vertex=v,
             )
         )
     return defects
@@ -525,8 +533,13 @@ def _hint(soup: Soup, defects: list[NonConformity], gap_tolerance: float) -> str
     return text + "; check_conformity=False / --no-conformity-check skips it)"
 
 
+def find_defects(soup: Soup, split: PatchSplit, gap_tolerance: float) -> list[NonConformity]:
+    """Every crossing, T-junction and gap of the soup (what :func:`check_conformity` raises)."""
+    return _crossings(soup, soup.tolerance) + _gaps(soup, split, gap_tolerance, soup.tolerance)
+
+
 def check_conformity(soup: Soup, split: PatchSplit, gap_tolerance: float) -> None:
     """Raise :class:`NonConformalError` when surfaces cross, touch or leave gaps."""
-    defects = _crossings(soup, soup.tolerance) + _gaps(soup, split, gap_tolerance, soup.tolerance)
+    defects = find_defects(soup, split, gap_tolerance)
     if defects:
         raise NonConformalError(defects, _hint(soup, defects, gap_tolerance))
