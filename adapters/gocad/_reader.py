@@ -389,7 +389,7 @@ class _Builder:
         if faces.shape[0] == 0:
             return
         duplicated = np.ones(faces.shape[0], dtype=bool)
-        duplicated[np.unique(np.sort(faces, axis=1), axis=0, return_index=True)[1]] = False
+        duplicated[_first_of_each_triangle(faces, xyz.shape[0])] = False
         corners = xyz[faces]
         with np.errstate(over="ignore", invalid="ignore"):
             normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
@@ -716,15 +716,33 @@ def _edge_keys(pairs: NDArray[np.int64], n: int) -> NDArray[np.int64]:
     return keys
 
 
+def _first_of_each_triangle(faces: NDArray[np.int64], n: int) -> NDArray[np.int64]:
+    """Index of the first face of each set of three vertices (in any order)."""
+    ordered = np.sort(faces, axis=1)
+    if n <= 2_000_000:  # n**3 fits in int64: one key per face, a 1-D sort
+        keys = (ordered[:, 0] * n + ordered[:, 1]) * n + ordered[:, 2]
+        first: NDArray[np.int64] = np.unique(keys, return_index=True)[1]
+        return first
+    first = np.unique(ordered, axis=0, return_index=True)[1]
+    return first
+
+
 def _border_edges(faces: NDArray[np.int64], parts: NDArray[np.int64], n: int) -> NDArray[np.int64]:
     """Keys (:func:`_edge_keys`) of the edges one triangle of a patch uses: the patches'
     borders."""
     if faces.size == 0:
         return np.zeros(0, dtype=np.int64)
     edges = faces[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2)
-    rows = np.column_stack([np.repeat(parts, 3), _edge_keys(edges, n)])
+    edge_keys = _edge_keys(edges, n)
+    n_parts = int(parts.max(initial=0)) + 1
+    if int(edge_keys.max()) < np.iinfo(np.int64).max // n_parts - n_parts:
+        # One int64 key per (patch, edge): a 1-D sort instead of a row-wise unique.
+        row_keys, counts = np.unique(edge_keys * n_parts + np.repeat(parts, 3), return_counts=True)
+        keys: NDArray[np.int64] = np.unique(row_keys[counts == 1] // n_parts)
+        return keys
+    rows = np.column_stack([np.repeat(parts, 3), edge_keys])
     unique, counts = np.unique(rows, axis=0, return_counts=True)
-    keys: NDArray[np.int64] = np.unique(unique[counts == 1, 1])
+    keys = np.unique(unique[counts == 1, 1])
     return keys
 
 

@@ -57,64 +57,64 @@ def _neighbour_pairs(faces: IntArray) -> tuple[IntArray, IntArray, BoolArray]:
     return face_a, face_b, start_a == start_b
 
 
+def _labels(n: int, a: IntArray, b: IntArray) -> IntArray:
+    """The lowest node of each node's component, nodes ``0 … n-1`` joined by pairs (a, b).
+
+    Hooking of the higher root onto the lower, then pointer jumping to the roots: each pass at
+    least halves the number of components that still have a link, so O(log n) passes of
+    numpy work (no Python loop per node or pair).
+    """
+    parent = np.arange(n, dtype=np.int64)
+    while a.size:
+        pa, pb = parent[a], parent[b]
+        moving = pa != pb
+        if not moving.any():
+            break
+        a, b, pa, pb = a[moving], b[moving], pa[moving], pb[moving]
+        np.minimum.at(parent, np.maximum(pa, pb), np.minimum(pa, pb))
+        while True:
+            grand = parent[parent]
+            if np.array_equal(grand, parent):
+                break
+            parent = grand
+    return parent
+
+
 def orientation_flips(faces: ArrayLike, roots: ArrayLike | None = None) -> OrientationFlips:
     """Flips making each connected piece of ``faces`` agree with its root face.
 
     ``roots`` optionally lists preferred root faces (e.g. a GOCAD TFACE's key triangle); a
     piece holding none of them is rooted at its lowest face.
+
+    Each face has two states (as is, ``2f``; reversed, ``2f + 1``); a shared manifold edge links
+    the states in which the two faces agree. The components of these states are the consistent
+    orientations: ``2f`` and ``2f + 1`` in one component make the piece non-orientable.
     """
     f = _as_faces(faces, "orientation_flips")
     m = f.shape[0]
     if m == 0:
         empty = np.zeros(0, dtype=np.int64)
         return OrientationFlips(np.zeros(0, dtype=np.bool_), empty, 0, 0)
-    from scipy.sparse import coo_matrix  # imported here: keeps `import geobrep` fast
-    from scipy.sparse.csgraph import breadth_first_order, connected_components
-
     face_a, face_b, same_way = _neighbour_pairs(f)
-    graph = coo_matrix(
-        (np.ones(face_a.shape[0], dtype=np.int8), (face_a, face_b)), shape=(m, m)
-    ).tocsr()
-    n_pieces, piece = connected_components(graph, directed=False)
-    piece = piece.astype(np.int64)
+    other = same_way.astype(np.int64)  # running the edge the same way: one of them must turn
+    state_a = np.concatenate([2 * face_a, 2 * face_a + 1])
+    state_b = np.concatenate([2 * face_b + other, 2 * face_b + 1 - other])
+    label = _labels(2 * m, state_a, state_b)
+    as_is, turned = label[0::2], label[1::2]
+    # Every state of a piece is >= 2 * its lowest face, and 2 * lowest is one of them.
+    lowest = np.minimum(as_is, turned) // 2
+    _, piece = np.unique(lowest, return_inverse=True)
+    piece = piece.astype(np.int64).reshape(-1)
+    n_pieces = int(piece.max()) + 1
     root_of_piece = np.full(n_pieces, m, dtype=np.int64)
     if roots is not None:
         preferred = np.asarray(roots, dtype=np.int64).reshape(-1)
         preferred = preferred[(preferred >= 0) & (preferred < m)]
         np.minimum.at(root_of_piece, piece[preferred], preferred)
-    lowest = np.full(n_pieces, m, dtype=np.int64)
-    np.minimum.at(lowest, piece, np.arange(m, dtype=np.int64))
-    root_of_piece = np.where(root_of_piece < m, root_of_piece, lowest)
-    # One breadth-first forest: a virtual node m joined to every root.
-    tree_rows = np.concatenate([face_a, face_b, np.full(n_pieces, m), root_of_piece])
-    tree_cols = np.concatenate([face_b, face_a, root_of_piece, np.full(n_pieces, m)])
-    forest = coo_matrix(
-        (np.ones(tree_rows.shape[0], dtype=np.int8), (tree_rows, tree_cols)), shape=(m + 1, m + 1)
-    ).tocsr()
-    _, predecessors = breadth_first_order(forest, m, directed=False, return_predecessors=True)
-    parent = predecessors[:m].astype(np.int64)
-    parent[parent == m] = root_of_piece[piece[parent == m]]
-    parent[root_of_piece] = root_of_piece
-    # Parity of the tree edge (f, parent[f]): look it up among the neighbour pairs.
-    pair_key = np.concatenate([face_a * (m + 1) + face_b, face_b * (m + 1) + face_a])
-    pair_parity = np.concatenate([same_way, same_way])
-    order = np.argsort(pair_key, kind="stable")
-    sorted_keys = pair_key[order]
-    wanted = np.arange(m, dtype=np.int64) * (m + 1) + parent
-    where = np.searchsorted(sorted_keys, wanted)
-    where = np.minimum(where, sorted_keys.shape[0] - 1) if sorted_keys.size else where
-    is_tree_edge = parent != np.arange(m)
-    parity = np.zeros(m, dtype=np.bool_)
-    if sorted_keys.size:
-        parity[is_tree_edge] = pair_parity[order[where[is_tree_edge]]]
-    # Pointer jumping: parity[f] becomes the xor of the tree edges from f up to its root.
-    jump = parent.copy()
-    while True:
-        further = jump[jump]
-        if np.array_equal(further, jump):
-            break
-        parity = parity ^ parity[jump]
-        jump = further
-    flip = parity
+    root_of_piece = np.where(
+        root_of_piece < m, root_of_piece, lowest[np.unique(piece, return_index=True)[1]]
+    )
+    orientable = as_is != turned
+    flip = orientable & (as_is != as_is[root_of_piece[piece]])
     conflicts = int(np.count_nonzero(same_way ^ flip[face_a] ^ flip[face_b]))
-    return OrientationFlips(flip=flip, piece=piece, n_pieces=int(n_pieces), n_conflicts=conflicts)
+    return OrientationFlips(flip=flip, piece=piece, n_pieces=n_pieces, n_conflicts=conflicts)

@@ -52,33 +52,33 @@ def orient_patches(
     winding the patch must follow; a label without one (or a piece of the patch that does not
     hold it) follows the majority of its faces. Returns the surface unchanged when nothing flips.
     """
-    references = reference_faces or {}
     faces = surface.faces
-    flip_all = np.zeros(faces.shape[0], dtype=np.bool_)
-    flipped: dict[int, int] = {}
-    for label in range(surface.n_patches):
-        members = surface.patch_faces(label)
-        if members.size < 2:
-            continue
-        reference = references.get(label)
-        local_root: list[int] = []
-        if reference is not None:
-            position = np.flatnonzero(members == reference)
-            local_root = [int(position[0])] if position.size else []
-        result = orientation_flips(faces[members], local_root or None)
-        flip = result.flip.copy()
-        # Pieces without the reference face follow their majority.
-        rooted = result.piece[local_root[0]] if local_root else -1
-        n_flipped = np.bincount(result.piece, weights=flip, minlength=result.n_pieces)
-        n_faces = np.bincount(result.piece, minlength=result.n_pieces)
-        invert = n_flipped * 2 > n_faces
-        if rooted >= 0:
-            invert[rooted] = False
-        flip ^= invert[result.piece]
-        count = int(np.count_nonzero(flip))
-        if count:
-            flipped[label] = count
-            flip_all[members[flip]] = True
+    if faces.shape[0] < 2:
+        return surface, {}
+    labels = (
+        np.zeros(faces.shape[0], dtype=np.int64)
+        if surface.patch_labels is None
+        else np.asarray(surface.patch_labels, dtype=np.int64)
+    )
+    # One pass over all patches: each patch gets vertices of its own, so no piece crosses two.
+    n_vertices = int(faces.max()) + 1
+    separate = faces + (labels * n_vertices)[:, None]
+    roots = [
+        face
+        for label, face in (reference_faces or {}).items()
+        if face is not None and 0 <= face < faces.shape[0] and labels[face] == label
+    ]
+    result = orientation_flips(separate, roots or None)
+    flip = result.flip.copy()
+    # Pieces without the reference face follow their majority.
+    n_flipped = np.bincount(result.piece, weights=flip, minlength=result.n_pieces)
+    n_faces = np.bincount(result.piece, minlength=result.n_pieces)
+    invert = n_flipped * 2 > n_faces
+    invert[result.piece[np.asarray(roots, dtype=np.int64)]] = False
+    flip ^= invert[result.piece]
+    flip_all = flip
+    counts = np.bincount(labels[flip], minlength=surface.n_patches)
+    flipped = {int(label): int(counts[label]) for label in np.flatnonzero(counts)}
     if not flipped:
         return surface, {}
     new_faces = faces.copy()
