@@ -7,6 +7,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -199,6 +200,41 @@ def test_import_is_light(record_property: Callable[[str, object], None]) -> None
     assert not loaded & {"open3d", "pyvista", "vtk", "vtkmodules", "trimesh", "matplotlib"}, loaded
     record_property("import_seconds", report["seconds"])
     print(f"\nimport geobrep: {report['seconds'] * 1000:.0f} ms; also loaded: {sorted(loaded)}")
+
+
+READ_PROBE = """
+import json, sys, warnings
+warnings.simplefilter("ignore")
+import geobrep
+geobrep.read(sys.argv[1])
+print(json.dumps(sorted(sys.modules)))
+"""
+
+#: What reading a small TSurf must not import: the plugins' kernels (their registration is
+#: enough to fill the registries), scipy and pyproj (no merge, no graph, no reprojection).
+NOT_FOR_A_TSURF = (
+    "scipy",
+    "pyproj",
+    "geobrep.plugins.blocks._",
+    "geobrep.plugins.clip._",
+    "geobrep.plugins.fit._",
+    "geobrep.plugins.voxelize._",
+    "geobrep.gis.crs_ops",
+)
+
+
+def test_reading_a_tsurf_imports_only_what_it_needs() -> None:
+    result = subprocess.run(
+        [sys.executable, "-c", READ_PROBE, str(Path(__file__).parent / "data/gocad/2triangles.ts")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    )
+    loaded = json.loads(result.stdout.splitlines()[-1])
+    unneeded = [m for m in loaded if m.startswith(NOT_FOR_A_TSURF) or m in NOT_FOR_A_TSURF]
+    assert not unneeded, unneeded
+    assert "geobrep.adapters.gocad._reader" in loaded  # the probe did read through GOCAD
 
 
 def test_validating_a_million_triangles(record_property: Callable[[str, object], None]) -> None:

@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 __all__ = ["TetFaces", "root_vertices"]
 
@@ -85,6 +83,9 @@ class TetFaces:
         a, b = self.order[shared], self.order[shared + 1]
         flat = barrier.reshape(-1)
         keep = ~(flat[a] | flat[b])
+        from scipy.sparse import coo_matrix  # imported here: reading a TSurf needs no scipy
+        from scipy.sparse.csgraph import connected_components
+
         graph = coo_matrix(
             (np.ones(int(keep.sum()), dtype=np.int8), (a[keep] // 4, b[keep] // 4)), shape=(n, n)
         )

@@ -9,27 +9,34 @@ stratified geological structure", taken from a plain triangle soup to validated 
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from geobrep.plugins import hookimpl
 
 if TYPE_CHECKING:
+    from geobrep import Scene
     from geobrep.plugins import BuilderRegistry
 
 __all__ = ["geobrep_register_builders"]
 
 
+def _build_blocks(scene: Scene, options: Any) -> Scene:
+    """The builder, imported on first use (not when the registries are filled)."""
+    from geobrep.plugins.blocks._builder import build_blocks
+
+    return build_blocks(scene, options)
+
+
 @hookimpl
 def geobrep_register_builders(registry: BuilderRegistry) -> None:
     from geobrep.plugins import BuilderSpec
-    from geobrep.plugins.blocks._builder import build_blocks
     from geobrep.plugins.blocks.options import BlockBuilderOptions
 
     registry.add(
         BuilderSpec(
             name="blocks",
             description="Closed, oriented blocks and their topology from conformal surfaces",
-            function=build_blocks,
+            function=_build_blocks,
             input_types=("Surface",),
             options=BlockBuilderOptions,
         )

@@ -6,6 +6,7 @@ context)``; see ``docs/clipping.md``. Each clipper lives in its own module of th
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -17,18 +18,25 @@ if TYPE_CHECKING:
 __all__ = ["geobrep_register_clippers"]
 
 
+def _deferred(module: str, name: str) -> Callable[..., Any]:
+    """``module.name``, imported on its first call: filling the registries imports no kernel."""
+    function: Callable[..., Any] | None = None
+
+    def call(*args: Any, **kwargs: Any) -> Any:
+        nonlocal function
+        if function is None:
+            function = getattr(importlib.import_module(f"geobrep.plugins.clip.{module}"), name)
+        return function(*args, **kwargs)
+
+    call.__name__ = call.__qualname__ = name
+    call.__module__ = f"geobrep.plugins.clip.{module}"
+    return call
+
+
 @hookimpl
 def geobrep_register_clippers(registry: ClipperRegistry) -> None:
-    """Register the built-in clippers (modules are imported here, on first use of a registry)."""
+    """Register the built-in clippers (their modules are imported on a clipper's first call)."""
     from geobrep.plugins import ClipperSpec
-    from geobrep.plugins.clip._blocks import clip_block, section_block
-    from geobrep.plugins.clip._lines import clip_polyline, section_polyline
-    from geobrep.plugins.clip._nurbs import clip_nurbs
-    from geobrep.plugins.clip._octree import clip_octree
-    from geobrep.plugins.clip._points import clip_pointset, section_pointset
-    from geobrep.plugins.clip._polygons import clip_polygon, section_polygon
-    from geobrep.plugins.clip._surfaces import clip_surface, section_surface
-    from geobrep.plugins.clip.annotations import clip_annotation
     from geobrep.plugins.clip.options import (
         AnnotationClipOptions,
         ClipOptions,
@@ -37,34 +45,34 @@ def geobrep_register_clippers(registry: ClipperRegistry) -> None:
         SurfaceClipOptions,
     )
 
-    # name, entity type, clipper, section (or None), options model, description
-    table: list[tuple[str, str, Callable[..., Any], Callable[..., Any] | None, type, str]] = [
-        ("surface", "Surface", clip_surface, section_surface, SurfaceClipOptions,
+    # name, entity type, module, clipper, section (or None), options model, description
+    table: list[tuple[str, str, str, str, str | None, type, str]] = [
+        ("surface", "Surface", "_surfaces", "clip_surface", "section_surface", SurfaceClipOptions,
          "Triangle and quad surfaces: shared cut vertices, interpolated point data, caps on "
          "closed surfaces"),
-        ("polyline", "PolyLine", clip_polyline, section_polyline, ClipOptions,
+        ("polyline", "PolyLine", "_lines", "clip_polyline", "section_polyline", ClipOptions,
          "Lines: runs of kept segments become parts, crossing points exact"),
-        ("polygon", "Polygon", clip_polygon, section_polygon, ClipOptions,
+        ("polygon", "Polygon", "_polygons", "clip_polygon", "section_polygon", ClipOptions,
          "Filled polygons with holes: pieces closed along the cut, holes nested"),
-        ("pointset", "PointSet", clip_pointset, section_pointset, ClipOptions,
+        ("pointset", "PointSet", "_points", "clip_pointset", "section_pointset", ClipOptions,
          "Points: those on the kept side (on the plane: both sides)"),
-        ("annotation", "Annotation", clip_annotation, None, AnnotationClipOptions,
+        ("annotation", "Annotation", "annotations", "clip_annotation", None, AnnotationClipOptions,
          "Text at string, character or stroke precision (built-in stroke font)"),
-        ("octree", "LinearOctree", clip_octree, None, OctreeClipOptions,
+        ("octree", "LinearOctree", "_octree", "clip_octree", None, OctreeClipOptions,
          "Linear octrees: leaves kept, dropped, or split down to the finest level"),
-        ("nurbs", "NurbsSurface", clip_nurbs, None, NurbsClipOptions,
+        ("nurbs", "NurbsSurface", "_nurbs", "clip_nurbs", None, NurbsClipOptions,
          "NURBS surfaces: exact trimming by half-spaces, found on the tessellation"),
-        ("block", "Block", clip_block, section_block, ClipOptions,
+        ("block", "Block", "_blocks", "clip_block", "section_block", ClipOptions,
          "Blocks of a scene: each cut block is closed by a cap patch"),
     ]  # fmt: skip
-    for name, entity_type, function, section, options, description in table:
+    for name, entity_type, module, function, section, options, description in table:
         registry.add(
             ClipperSpec(
                 name=name,
                 description=description,
                 entity_type=entity_type,
-                function=function,
-                section=section,
+                function=_deferred(module, function),
+                section=None if section is None else _deferred(module, section),
                 options=options,
             )
         )
