@@ -215,7 +215,7 @@ print(json.dumps(sorted(sys.modules)))
 NOT_FOR_A_TSURF = (
     "scipy",
     "pyproj",
-    "geobrep.plugins.blocks._",
+    "geobrep.plugins.blocks._builder",
     "geobrep.plugins.clip._",
     "geobrep.plugins.fit._",
     "geobrep.plugins.voxelize._",
