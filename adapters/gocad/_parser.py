@@ -57,6 +57,7 @@ from geobrep.adapters.gocad._tables import (
     VertexTable,
     check_finite_ids,
 )
+from geobrep.adapters.limits import human_bytes, read_budget
 from geobrep.errors import FormatError
 
 __all__ = ["GocadObject", "GocadWarning", "parse_source"]
@@ -75,6 +76,7 @@ KNOWN_TYPES = {
 GROUP_TYPES = ("HeterogeneousGroup", "HomogeneousGroup")
 FLAG_NAMES = {"CNXYZ": 1, "XYZ": 2}
 _CELL_PREFIX = {"TSurf": "TRGL_", "PLine": "SEG_", "TSolid": "TETRA_", "LightTSolid": "TETRA_"}
+_ABSENT_SHARE = 8
 _CELL_WIDTH = {"TSurf": 3, "PLine": 2, "TSolid": 4, "LightTSolid": 4, "Model3d": 3}
 _CELL_KEYWORD = {"TSurf": "TRGL", "PLine": "SEG", "TSolid": "TETRA", "LightTSolid": "TETRA"}
 _PART_KEYWORDS = {"TFACE", "3DFACE", "ILINE", "TVOLUME", "SUBVSET"}
@@ -537,7 +539,30 @@ class _Parser:
                 )
         width = _CELL_WIDTH.get(obj.type)
         cells = CellTable(width, obj.cell_header.n_values) if width else None
-        return VertexTable(obj.point_header.n_values), cells
+        # Values no line holds (VRTX lines in an object with properties, ATOM lines inheriting
+        # theirs) are filled in: at most an eighth of the read budget of them (8 bytes each),
+        # since the vertex table is copied a few times on its way to the properties.
+        absent_limit = read_budget(len(self.source.data)) // _ABSENT_SHARE // 8
+        return VertexTable(obj.point_header.n_values, absent_limit), cells
+
+    def _check_absent(
+        self, obj: GocadObject, vertices: VertexTable, rows: int, keyword: str, line: int
+    ) -> None:
+        """Count ``rows`` vertices from ``line`` on that carry no property values; FormatError
+        at the first of them past the limit of values filled in."""
+        past = vertices.allow_absent(rows)
+        if past is None:
+            return
+        n_values = vertices.n_values
+        limit = human_bytes(8 * (vertices.absent_limit or 0)).replace(".0 ", " ")
+        raise self.error(
+            f"{keyword}: {obj.type} {obj.name!r} declares {n_values} property values per vertex "
+            f"and its vertices up to this line carry none of their own (VRTX lines, ATOM lines "
+            f"inheriting them): filling them in would take more than {limit}, an eighth of the "
+            f"read budget of "
+            f"this {len(self.source.data)}-byte file (write the values on PVRTX lines)",
+            line + past,
+        )
 
     def _new_part(self, obj: GocadObject, name: str, vertices: VertexTable, line: int) -> int:
         obj.part_names.append(name)
@@ -579,6 +604,7 @@ class _Parser:
             if run.keyword == "PVRTX":
                 values = self._finite(obj, "point", block[:, 4:], run.first)
             else:
+                self._check_absent(obj, vertices, run.count, run.keyword, run.first)
                 values = self._no_values(obj, run.count)
             vertices.add_block(ids, np.ascontiguousarray(block[:, 1:4]), values, run.first)
             return part
@@ -730,6 +756,7 @@ class _Parser:
         if values is not None and not all(map(math.isfinite, values)):
             values = self._finite(obj, "point", np.array([values]), number)[0].tolist()
         if values is None and n_values:
+            self._check_absent(obj, vertices, 1, keyword, number)
             values = [np.nan] * n_values
         vertices.add(parse_int(tokens[1]), xyz, None, values, flag, number)
 
@@ -751,6 +778,8 @@ class _Parser:
             values = [parse_float(t) for t in tokens[3 : 3 + n_values]]
             if not all(map(math.isfinite, values)):
                 values = self._finite(obj, "point", np.array([values]), number)[0].tolist()
+        elif n_values:
+            self._check_absent(obj, vertices, 1, keyword, number)
         vertices.add(parse_int(tokens[1]), None, parse_int(tokens[2]), values, flag, number)
 
     def _part_line(

@@ -34,8 +34,12 @@ class _Pending:
 class VertexTable:
     """Vertices in declaration order: ids, coordinates, property values, flags, lines."""
 
-    def __init__(self, n_values: int) -> None:
+    def __init__(self, n_values: int, absent_limit: int | None = None) -> None:
         self.n_values = n_values
+        self.absent = 0
+        """Property values the file does not hold: vertices without values (VRTX lines, ATOM
+        lines inheriting theirs) times ``n_values``."""
+        self.absent_limit = absent_limit
         self._chunks: list[
             tuple[IntArray, FloatArray, IntArray, FloatArray, NDArray[np.int8], IntArray]
         ] = []
@@ -60,6 +64,14 @@ class VertexTable:
         pending.lines.append(line)
         if values is None and self.n_values:
             pending.flags[-1] |= _INHERIT
+
+    def allow_absent(self, rows: int) -> int | None:
+        """Count ``rows`` vertices that carry no values of their own; ``None`` while the values
+        filled in for them stay within ``absent_limit``, else the index of the row past it."""
+        before, self.absent = self.absent, self.absent + rows * self.n_values
+        if self.absent_limit is None or self.absent <= self.absent_limit:
+            return None
+        return max(0, (self.absent_limit - before) // self.n_values)
 
     def add_block(
         self, ids: IntArray, xyz: FloatArray, values: FloatArray, first_line: int

@@ -21,6 +21,7 @@ from gocad_files import DATA
 import geobrep
 from geobrep.adapters.gocad._lexer import Source, split_tokens
 from geobrep.adapters.gocad._parser import GocadWarning
+from geobrep.adapters.limits import BUDGET_FLOOR
 
 TESTS_DATA = DATA.parent
 RELIABILITY = TESTS_DATA / "reliability" / "gocad"
@@ -387,3 +388,35 @@ def test_model3d_ids_must_be_positive(tmp_path: Path, line: str, message: str) -
     with pytest.raises(geobrep.FormatError, match=re.escape(message)) as caught:
         geobrep.read(path)
     assert caught.value.line == 5
+
+
+def _vrtx_without_values(tmp_path: Path, rows: int) -> Path:
+    path = tmp_path / "wide.vs"
+    vertices = "".join(f"VRTX {i} {i} 0 0\n" for i in range(1, rows + 1))
+    path.write_text(
+        f"GOCAD VSet 1\nHEADER {{\nname: wide\n}}\nPROPERTIES a b\nESIZES 999 1\n"
+        f"PVRTX 0 0 0 0 {' '.join(['2'] * 1000)}\n{vertices}END\n",
+        encoding="utf-8",
+    )
+    return path
+
+
+def test_vrtx_lines_without_values_are_filled_in_up_to_the_limit(tmp_path: Path) -> None:
+    """VRTX lines may carry no values in an object with properties (GOCAD mixes VRTX and PVRTX):
+    no-data for them, up to an eighth of the read budget (2,097,152 values at the floor)."""
+    rows = BUDGET_FLOOR // 8 // 8 // 1000
+    scene = geobrep.read(_vrtx_without_values(tmp_path, rows))
+    (points,) = scene.entities
+    b = np.asarray(points.point_data["b"])
+    assert b.shape == (rows + 1,)
+    assert b[0] == 2
+    assert np.isnan(b[1:]).all()
+
+
+def test_vrtx_lines_without_values_past_the_limit_are_refused(tmp_path: Path) -> None:
+    """Padding every value-less vertex with the header's 1000 values took 8 kB of memory per
+    15-byte line (0.96 GB for a 3 MB file of 399 values: tests/reliability has that case)."""
+    rows = BUDGET_FLOOR // 8 // 8 // 1000
+    with pytest.raises(geobrep.FormatError, match="declares 1000 property values per ver") as c:
+        geobrep.read(_vrtx_without_values(tmp_path, rows + 1))
+    assert c.value.line == 7 + rows + 1  # the first VRTX past the limit

@@ -225,3 +225,20 @@ def zlib_bomb_vtu(path: Path, inflated: int = 3200 * MIB, lie: bool = False) -> 
         "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n"
     )
     return path
+
+
+def wide_gocad_header(path: Path, rows: int = 150_000, atoms: bool = False) -> Path:
+    """A GOCAD VSet (about 3 MB) whose header declares 200 properties of ESIZE 1 to 3 (399
+    values per vertex) while its ``rows`` VRTX lines carry none (``atoms``: one PVRTX with the
+    values, then ATOM lines inheriting them). Padding every vertex took 0.96 GB (1.8 GB with
+    ATOMs) before the values filled in were bounded."""
+    names = " ".join(f"p{i}" for i in range(200))
+    esizes = " ".join(str(1 + i % 3) for i in range(200))
+    head = f"GOCAD VSet 1\nHEADER {{\nname: wide\n}}\nPROPERTIES {names}\nESIZES {esizes}\n"
+    if atoms:
+        body = f"PVRTX 1 0 0 0 {' '.join(['1'] * 399)}\n"
+        body += "".join(f"ATOM {i} 1\n" for i in range(2, rows + 1))
+    else:
+        body = "".join(f"VRTX {i} {i} 0 0\n" for i in range(1, rows + 1))
+    path.write_text(head + body + "END\n", encoding="utf-8")
+    return path

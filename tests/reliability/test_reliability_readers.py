@@ -19,6 +19,7 @@ from read_probe import (
     huge_array_geobrep,
     memory_bound,
     probe_reads,
+    wide_gocad_header,
     zlib_bomb_vtu,
 )
 
@@ -94,6 +95,12 @@ def bombs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         ),
         "zlib VTU bomb (3.2 GB)": zlib_bomb_vtu(folder / "bomb.vtu"),
         "zlib VTU bomb with understated blocks": zlib_bomb_vtu(folder / "bomb_lie.vtu", lie=True),
+        "GOCAD header of 399 values per vertex, VRTX lines without": wide_gocad_header(
+            folder / "wide.vs"
+        ),
+        "GOCAD header of 399 values per vertex, ATOM lines inheriting": wide_gocad_header(
+            folder / "atoms.vs", atoms=True
+        ),
     }
 
 
@@ -121,6 +128,10 @@ def test_every_hostile_file_is_refused_within_the_memory_bound(bombs: dict[str, 
         "block 0 inflates to more than the 4.0 KiB" in said["zlib VTU bomb with understated blocks"]
     )
     assert "declares 3.1 GiB" in said["zlib VTU bomb (3.2 GB)"]
+    for kind in ("VRTX lines without", "ATOM lines inheriting"):
+        message = said[f"GOCAD header of 399 values per vertex, {kind}"]
+        assert "declares 399 property values per vertex" in message, message
+        assert "filling them in would take more than 16 MiB" in message, message
 
 
 # -- item 6: values that do not fit the declared type --------------------------------------------
