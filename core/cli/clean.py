@@ -1,8 +1,9 @@
 """``geobrep clean FOLDER``: remove the temporaries that killed geobrep writes left behind.
 
 Only names of geobrep temporaries (``.{stem}.tmp-{pid}-{8 hex digits}{suffix}``) whose process
-is gone are removed (see :mod:`geobrep.ops.temporaries`); a temporary of a running process and
-every other file are kept. ``--dry-run`` lists what would be removed.
+is gone are removed (see :mod:`geobrep.ops.temporaries`), and those of earlier geobrep versions
+(``.{stem}.tmp-{8 hex digits}{suffix}``, no pid) once a day old; a temporary of a running
+process and every other file are kept. ``--dry-run`` lists what would be removed.
 """
 
 from __future__ import annotations
@@ -25,7 +26,8 @@ def add_parser(subparsers: Any) -> None:
         description=(
             "Remove the temporary files that interrupted (killed) geobrep writes left in FOLDER: "
             "names like .model.tmp-4242-0a1b2c3d.vtu whose process 4242 is gone. Temporaries "
-            "of running processes and all other files are kept."
+            "of running processes and all other files are kept. Temporaries of earlier geobrep "
+            "versions (.model.tmp-0a1b2c3d.vtu, no pid) are removed once a day old."
         ),
     )
     parser.add_argument("folder", type=Path, help="folder to clean")
@@ -71,10 +73,13 @@ def run(args: argparse.Namespace) -> int:
     done = [row for row in rows if row["action"] in ("removed", "would remove")]
     failed = [row for row in rows if row["action"] == "could not remove"]
     verb = "would remove" if args.dry_run else "removed"
+    kept = [row for row in rows if row["action"] == "kept"]
+    recent = sum(row["pid"] is None for row in kept)
     print(
         f"{verb} {len(done)} stale temporar{'y' if len(done) == 1 else 'ies'} "
         f"({_megabytes(sum(row['bytes'] for row in done))}); "
-        f"kept {len(rows) - len(done) - len(failed)} of running processes"
+        f"kept {len(kept) - recent} of running processes"
+        + (f" and {recent} of earlier geobrep versions under a day old" if recent else "")
         + (f"; could not remove {len(failed)}" if failed else "")
     )
     return 1 if failed else 0

@@ -10,11 +10,17 @@ pid started after the file was last modified (the pid was reused). Only processe
 machine (and PID namespace) can be seen: do not clean a folder that a writer on another machine
 is writing into. On Windows nothing is considered stale.
 
+geobrep before issue 15 named temporaries ``.{stem}.tmp-{random}{suffix}``, without a pid
+(:data:`LEGACY_TEMPORARY_PATTERN`). No process can be checked for those: one is stale when it
+was last modified more than :data:`LEGACY_STALE_AGE` ago (a day), far longer than any write.
+
 Example:
     >>> parse_temporary(".model.tmp-4242-0a1b2c3d.vtu")
     (4242, 'model')
     >>> parse_temporary("model.vtu") is None
     True
+    >>> parse_legacy_temporary(".model.tmp-0a1b2c3d.vtu")
+    'model'
 """
 
 from __future__ import annotations
@@ -23,14 +29,18 @@ import os
 import re
 import secrets
 import shutil
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = [
+    "LEGACY_STALE_AGE",
+    "LEGACY_TEMPORARY_PATTERN",
     "TEMPORARY_PATTERN",
     "Temporary",
     "find_temporaries",
+    "parse_legacy_temporary",
     "parse_temporary",
     "remove_stale_temporaries",
     "temporary_path",
@@ -40,6 +50,15 @@ TEMPORARY_PATTERN = re.compile(
     r"^\.(?P<stem>.+)\.tmp-(?P<pid>[1-9][0-9]{0,9})-(?P<token>[0-9a-f]{8})(?P<suffix>\.[^.]+)?$"
 )
 """The name of a geobrep temporary: ``.{stem}.tmp-{pid}-{8 hex digits}{suffix}``."""
+
+LEGACY_TEMPORARY_PATTERN = re.compile(
+    r"^\.(?P<stem>.+)\.tmp-(?P<token>[0-9a-f]{8})(?P<suffix>\.[^.]+)?$"
+)
+"""The name earlier geobrep versions gave a temporary: ``.{stem}.tmp-{8 hex digits}{suffix}``."""
+
+LEGACY_STALE_AGE = 24 * 3600.0
+"""Seconds after its last change when a temporary without a pid (:data:`LEGACY_TEMPORARY_PATTERN`)
+is stale: a day."""
 
 _SLACK = 2.0
 """Seconds of doubt between a file's time and a process's start (boot time has 1 s steps)."""
@@ -62,6 +81,16 @@ def parse_temporary(name: str) -> tuple[int, str] | None:
     if match is None:
         return None
     return int(match["pid"]), match["stem"].lstrip(".").split(".tmp-")[0]
+
+
+def parse_legacy_temporary(name: str) -> str | None:
+    """The target's stem of an earlier geobrep's temporary name (no pid), or ``None``."""
+    if TEMPORARY_PATTERN.match(name):
+        return None
+    match = LEGACY_TEMPORARY_PATTERN.match(name)
+    if match is None:
+        return None
+    return match["stem"].lstrip(".").split(".tmp-")[0]
 
 
 def _process_start(pid: int) -> float | None:
@@ -99,13 +128,24 @@ class Temporary:
     """A geobrep temporary found in a folder."""
 
     path: Path
-    pid: int
+    pid: int | None
+    """The writing process; ``None`` for a temporary of an earlier geobrep (no pid in its name)."""
     stale: bool
     size: int
+    age: float = 0.0
+    """Seconds since it was last modified (when it was found)."""
 
     @property
     def reason(self) -> str:
         """Why it is stale or kept, in words."""
+        if self.pid is None:
+            hours = f"last modified {self.age / 3600:.1f} h ago"
+            if self.stale:
+                return f"an earlier geobrep's (no pid), {hours}"
+            return (
+                f"an earlier geobrep's (no pid), {hours}: kept until "
+                f"{LEGACY_STALE_AGE / 3600:.0f} h old"
+            )
         if self.stale:
             return f"process {self.pid} is gone"
         return f"process {self.pid} is running"
@@ -122,14 +162,18 @@ def _size(path: Path) -> int:
 
 def _examine(path: Path) -> Temporary | None:
     parsed = parse_temporary(path.name)
-    if parsed is None:
+    if parsed is None and parse_legacy_temporary(path.name) is None:
         return None
     try:
         modified = path.lstat().st_mtime
     except OSError:
         return None  # gone meanwhile
+    age = time.time() - modified
+    if parsed is None:  # an earlier geobrep's: no process to ask, only its age
+        stale = os.name != "nt" and age > LEGACY_STALE_AGE
+        return Temporary(path=path, pid=None, stale=stale, size=_size(path), age=age)
     stale = not _owner_running(parsed[0], modified)
-    return Temporary(path=path, pid=parsed[0], stale=stale, size=_size(path))
+    return Temporary(path=path, pid=parsed[0], stale=stale, size=_size(path), age=age)
 
 
 def _entries(folder: Path, recursive: bool) -> Iterator[Path]:

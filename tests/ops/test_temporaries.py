@@ -186,3 +186,61 @@ def test_geobrep_clean_removes_stale_and_keeps_live_and_other_files(
 def test_geobrep_clean_needs_a_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["clean", str(tmp_path / "missing")]) == 1
     assert "not a folder" in capsys.readouterr().err
+
+
+def _legacy(folder: Path, name: str, hours: float) -> Path:
+    """A temporary named as geobrep wrote them before issue 15 (``.tmp-{8 hex}``, no pid)."""
+    path = folder / name
+    path.write_bytes(b"x" * 1000)
+    when = time.time() - hours * 3600
+    os.utime(path, (when, when))
+    return path
+
+
+def test_temporaries_of_earlier_versions_are_stale_after_a_day(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Earlier geobrep named temporaries .{stem}.tmp-{token_hex(4)}{suffix}: no pid to check."""
+    old = _legacy(tmp_path, ".model.tmp-1530bb30.vtu", hours=30)
+    nested = _legacy(tmp_path, "..model.tmp-1530bb30.tmp-0a1b2c3d.vtu", hours=25)
+    recent = _legacy(tmp_path, ".model.tmp-2b3c4d5e.vtu", hours=2)
+    others = [
+        _legacy(tmp_path, ".model.tmp-1530bb3.vtu", hours=30),  # 7 hex digits
+        _legacy(tmp_path, ".model.tmp-1530BB30.vtu", hours=30),  # not lower-case hex
+        _legacy(tmp_path, "model.tmp-1530bb30.vtu", hours=30),  # not hidden
+    ]
+    found = {t.path: t for t in find_temporaries(tmp_path)}
+    assert set(found) == {old, nested, recent}
+    assert [found[p].stale for p in (old, nested, recent)] == [True, True, False]
+    assert found[old].pid is None
+
+    assert main(["clean", str(tmp_path), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert f"would remove  {old}  (0.0 MB, an earlier geobrep's (no pid), last modified 30" in out
+    assert f"kept  {recent}  (0.0 MB, an earlier geobrep's (no pid), last modified 2.0 h" in out
+    assert out.rstrip().endswith(
+        "would remove 2 stale temporaries (0.0 MB); kept 0 of running processes and 1 of "
+        "earlier geobrep versions under a day old"
+    )
+    assert all(p.exists() for p in (old, nested, recent, *others))
+
+    assert main(["clean", str(tmp_path), "--json"]) == 0
+    rows = {Path(row["path"]).name: row for row in json.loads(capsys.readouterr().out)}
+    assert {name: (row["action"], row["pid"]) for name, row in rows.items()} == {
+        old.name: ("removed", None),
+        nested.name: ("removed", None),
+        recent.name: ("kept", None),
+    }
+    assert all(p.exists() for p in (recent, *others))
+
+
+def test_a_write_removes_the_targets_day_old_temporaries_of_earlier_versions(
+    tmp_path: Path,
+) -> None:
+    old = _legacy(tmp_path, ".model.tmp-1530bb30.ply", hours=48)
+    recent = _legacy(tmp_path, ".model.tmp-2b3c4d5e.ply", hours=1)
+    other_target = _legacy(tmp_path, ".other.tmp-1530bb30.ply", hours=48)
+    geobrep.write(geobrep.PointSet(name="p", vertices=np.zeros((1, 3))), tmp_path / "model.ply")
+    assert not old.exists()
+    assert recent.exists()
+    assert other_target.exists()
