@@ -17,9 +17,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters._file_format import file_format, full_capabilities
@@ -160,10 +161,27 @@ def _read_through_pyvista(path: Path) -> Scene:
 
 def _write_legacy(scene: Scene, path: Path, options: LegacyVtkOptions) -> None:
     layout = scene_to_layout(scene)
+    layout.point_data = _legacy_types(layout.point_data)
+    layout.cell_data = _legacy_types(layout.cell_data)
     mesh = mesh_from_layout(layout, field_data=False)
     write_mesh(mesh, path, "vtk", binary=options.binary)
     if layout.header is not None:
         embed_legacy_header(path, layout.header, options.binary)
+
+
+def _legacy_types(arrays: dict[str, NDArray[Any]]) -> dict[str, NDArray[Any]]:
+    """Arrays in types that VTK's legacy reader and meshio's both know as meshio names them:
+    integers narrower than 64 bits (``vtktypeint32``, ``vtktypeuint8``: unknown to VTK) as
+    int64, half floats as float32. Lossless; the header's property records keep the dtype."""
+    widened: dict[str, NDArray[Any]] = {}
+    for name, values in arrays.items():
+        array = np.asarray(values)
+        if array.dtype.kind == "b" or (array.dtype.kind in "iu" and array.dtype.itemsize < 8):
+            array = array.astype(np.int64)
+        elif array.dtype.kind == "f" and array.dtype.itemsize < 4:
+            array = array.astype(np.float32)
+        widened[name] = array
+    return widened
 
 
 def check_off_counts(path: Path) -> None:

@@ -27,7 +27,9 @@ __all__ = [
 ]
 
 _TAIL = 4096
-_LEGACY_HEAD = 1 << 22
+_LEGACY_HEAD = 1 << 24
+#: The types geobrep stored its legacy header as: ``float`` now, ``vtktypeuint8`` before.
+_HEADER_TYPES = {"float": np.dtype(">f4"), "vtktypeuint8": np.dtype("u1")}
 
 
 def embed_vtu_header(path: Path, header: dict[str, Any]) -> None:
@@ -51,12 +53,16 @@ def embed_vtu_header(path: Path, header: dict[str, Any]) -> None:
 
 
 def embed_legacy_header(path: Path, header: dict[str, Any], binary: bool) -> None:
-    """Insert a ``FIELD FieldData`` section holding the header after the ``DATASET`` line."""
+    """Insert a ``FIELD FieldData`` section holding the header after the ``DATASET`` line.
+
+    Its bytes are stored as ``float`` (32-bit, big-endian when binary; each byte exactly): the
+    one array type VTK's legacy reader and meshio's both read the same way. (geobrep before
+    issue 15 wrote ``vtktypeuint8``, which VTK does not know; ``unsigned_char`` meshio 5.3.5
+    does not; ``int`` is 4 bytes to VTK and 8 to meshio.)
+    """
     data = encode_header(header)
-    body = data.tobytes() if binary else " ".join(map(str, data.tolist())).encode()
-    section = (
-        f"FIELD FieldData 1\n{HEADER_ARRAY} 1 {data.size} vtktypeuint8\n".encode() + body + b"\n"
-    )
+    body = data.astype(">f4").tobytes() if binary else " ".join(map(str, data.tolist())).encode()
+    section = f"FIELD FieldData 1\n{HEADER_ARRAY} 1 {data.size} float\n".encode() + body + b"\n"
     staged = path.with_name(path.name + ".body")
     path.rename(staged)
     try:
@@ -88,13 +94,16 @@ def read_legacy_header(path: Path) -> dict[str, Any] | None:
         return None
     binary = b"\nBINARY" in head[:256]
     start = line_end + 1
+    stored = _HEADER_TYPES.get(fields[3].decode("latin-1").lower() if len(fields) > 3 else "")
+    if stored is None:
+        return None
     if binary:
-        raw = np.frombuffer(head[start : start + count], dtype=np.uint8)
+        raw = np.frombuffer(head[start : start + count * stored.itemsize], dtype=stored)
     else:
         stop = head.find(b"\n", start)
         try:
-            raw = np.array(head[start:stop].split(), dtype=np.uint8)
-        except (ValueError, OverflowError):  # not bytes: not a header geobrep wrote
+            raw = np.array(head[start:stop].split(), dtype=np.float64)
+        except (ValueError, OverflowError):  # not numbers: not a header geobrep wrote
             return None
     if raw.size != count:
         return None

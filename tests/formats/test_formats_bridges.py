@@ -191,3 +191,63 @@ def test_open3d_bridge_keeps_float64() -> None:
     assert isinstance(voxels, LinearOctree)
     assert voxels.volume == octree.volume
     np.testing.assert_array_equal(voxels.origin, octree.origin)
+
+
+@pytest.mark.parametrize("binary", [False, True])
+def test_legacy_vtk_reads_in_vtk_and_meshio(tmp_path: Path, scene: Scene, binary: bool) -> None:
+    """geobrep's legacy header was vtktypeuint8 (VTK: "Unsupported data type") and its int32
+    cell arrays vtktypeint32 (the same); ``unsigned_char`` meshio 5.3.5 does not read."""
+    vtk = pytest.importorskip("vtkmodules.vtkIOLegacy")
+    import meshio
+
+    from geobrep.adapters.cell_layout import HEADER_ARRAY, decode_header
+
+    labels = PointSet(
+        vertices=np.eye(3),
+        name="labels",
+        point_data={
+            "small": np.array([1, 200, 255], dtype=np.uint8),
+            "short": np.array([-3, 0, 30000], dtype=np.int16),
+            "flag": np.array([True, False, True]),
+        },
+    )
+    kept = scene.replace(entities=[*scene.entities, labels])
+    path = write(kept, tmp_path / "model.vtk", binary=binary)
+    errors: list[str] = []
+    reader = vtk.vtkUnstructuredGridReader()
+    reader.AddObserver("ErrorEvent", lambda _obj, _event: errors.append("error"))
+    reader.SetFileName(str(path))
+    reader.ReadAllFieldsOn()
+    reader.Update()
+    grid = reader.GetOutput()
+    assert errors == []
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    stored = vtk_to_numpy(grid.GetFieldData().GetArray(HEADER_ARRAY))
+    header = scene_to_layout(restrict_scene(kept, registries().formats.get("vtk").capabilities))
+    assert decode_header(stored) == header.header
+    mesh = meshio.read(path)
+    assert grid.GetNumberOfPoints() == len(mesh.points) == len(header.points)
+    for name, values in header.cell_data.items():
+        in_vtk = vtk_to_numpy(grid.GetCellData().GetArray(name))
+        np.testing.assert_array_equal(in_vtk, values)
+        np.testing.assert_array_equal(np.concatenate(mesh.cell_data[name]), values)
+    for name, values in header.point_data.items():
+        np.testing.assert_array_equal(vtk_to_numpy(grid.GetPointData().GetArray(name)), values)
+        np.testing.assert_array_equal(mesh.point_data[name], values)
+    (back,) = [e for e in read(path).entities if e.name == "labels"]
+    for name in ("small", "short", "flag"):
+        assert back.point_data[name].values.dtype == labels.point_data[name].values.dtype
+        np.testing.assert_array_equal(back.point_data[name].values, labels.point_data[name].values)
+
+
+def test_legacy_vtk_header_of_earlier_versions_still_reads(tmp_path: Path, scene: Scene) -> None:
+    """Files geobrep wrote before stored the header as vtktypeuint8 bytes."""
+    path = write(scene, tmp_path / "new.vtk", binary=True)
+    data = path.read_bytes()
+    head, rest = data.split(b" float\n", 1)
+    count = int(head.rsplit(b" ", 1)[1])
+    raw = np.frombuffer(rest[: 4 * count], dtype=">f4").astype(np.uint8).tobytes()
+    old = tmp_path / "old.vtk"
+    old.write_bytes(head + b" vtktypeuint8\n" + raw + rest[4 * count :])
+    assert read(old).entities == read(path).entities
