@@ -29,7 +29,7 @@ __all__ = [
 _TAIL = 4096
 _LEGACY_HEAD = 1 << 24
 #: The types geobrep stored its legacy header as: ``float`` now, ``vtktypeuint8`` before.
-_HEADER_TYPES = {"float": np.dtype(">f4"), "vtktypeuint8": np.dtype("u1")}
+_HEADER_TYPES: dict[str, np.dtype[Any]] = {"float": np.dtype(">f4"), "vtktypeuint8": np.dtype("u1")}
 
 
 def embed_vtu_header(path: Path, header: dict[str, Any]) -> None:
