@@ -30,6 +30,7 @@ if TYPE_CHECKING:
         FormatRegistry,
         VoxelizerRegistry,
     )
+    from geobrep.host.operations import OperationRegistry
 
 __all__ = ["PROJECT_NAME", "GeobrepSpecs", "hookimpl", "hookspec"]
 
@@ -124,5 +125,21 @@ class GeobrepSpecs:
             def geobrep_register_checks(registry):
                 registry.add(CheckSpec(
                     name="mesh.long_edges", function=find_long_edges, options=LongEdgeOptions,
+                ))
+        """
+
+    @hookspec
+    def geobrep_register_operations(self, registry: OperationRegistry) -> None:
+        """Register operations: :class:`~geobrep.plugins.OperationSpec` items, each a function of
+        a Scene with an options model. Each gets a Python function, a ``geobrep`` subcommand, a
+        pipeline step and a line in ``geobrep plugins``, all derived from the declaration.
+
+        Example::
+
+            @hookimpl
+            def geobrep_register_operations(registry):
+                registry.add(OperationSpec(
+                    name="thin", summary="keep every n-th point", function=thin,
+                    options=ThinOptions,
                 ))
         """

@@ -16,8 +16,8 @@ and implementing any of the hooks of :mod:`geobrep.hookspecs`::
 
 Everything a plugin needs is importable from here: the :data:`hookimpl` marker, the spec and
 registry types (``FormatSpec``, ``ClipperSpec``, ``FitterSpec``, ``BuilderSpec``,
-``VoxelizerSpec``, ``CheckSpec``, ...) and the Protocols their callables follow (``Reader``,
-``Writer``, ``ClipFunction``, ``FitFunction``, ...), the clipping context (``ClipContext``,
+``VoxelizerSpec``, ``CheckSpec``, ``OperationSpec`` and its ``Cli`` marker, ...) and the
+Protocols their callables follow (``Reader``, ``Writer``, ``ClipFunction``, ``FitFunction``, ...), the clipping context (``ClipContext``,
 ``SceneDraft``, ``halves``, ``pack_halves``), the fit result types (``FitResult``, ``FitReport``),
 ``atomic_write``, the topology helpers (``chain_arc_edges``, ``build_corners_and_arcs``) and the
 errors. The model
@@ -54,6 +54,14 @@ if TYPE_CHECKING:
     )
     from geobrep.host.loader import (
         PluginInfo,
+    )
+    from geobrep.host.operations import (
+        Cli,
+        OperationFunction,
+        OperationRegistry,
+        OperationSpec,
+        comma_items,
+        comma_numbers,
     )
     from geobrep.host.registry import (
         SNIFF_BYTES,
@@ -126,6 +134,7 @@ __all__ = [
     "CheckFunction",
     "CheckRegistry",
     "CheckSpec",
+    "Cli",
     "ClipContext",
     "ClipFunction",
     "ClipperRegistry",
@@ -150,6 +159,9 @@ __all__ = [
     "LossReporter",
     "MissingDependencyError",
     "NoOptions",
+    "OperationFunction",
+    "OperationRegistry",
+    "OperationSpec",
     "OptionsError",
     "PluginError",
     "PluginInfo",
@@ -169,6 +181,8 @@ __all__ = [
     "atomic_write",
     "build_corners_and_arcs",
     "chain_arc_edges",
+    "comma_items",
+    "comma_numbers",
     "halves",
     "hookimpl",
     "list_plugins",
@@ -181,6 +195,12 @@ __all__ = [
 #: Where each lazily imported name lives.
 _LAZY = {
     "PluginInfo": "geobrep.host.loader",
+    "Cli": "geobrep.host.operations",
+    "OperationFunction": "geobrep.host.operations",
+    "OperationRegistry": "geobrep.host.operations",
+    "OperationSpec": "geobrep.host.operations",
+    "comma_items": "geobrep.host.operations",
+    "comma_numbers": "geobrep.host.operations",
     "SNIFF_BYTES": "geobrep.host.registry",
     "BuilderRegistry": "geobrep.host.registry",
     "BuilderSpec": "geobrep.host.registry",

@@ -50,10 +50,19 @@ from pydantic import (
     field_validator,
     model_validator,
 )
+from pydantic.json_schema import SkipJsonSchema
 
 from geobrep.batch.limits import MAX_FILE_BYTES, check_json_depth, load_yaml
 from geobrep.batch.outputs import NAME_FIELDS, check_name_pattern, format_name
 from geobrep.errors import FileAccessError, FormatError, GeobrepError, OptionsError
+from geobrep.host.operations import (
+    Cli,
+    as_dict,
+    as_nested_dict,
+    comma_items,
+    comma_numbers,
+    key_value,
+)
 
 if TYPE_CHECKING:
     from geobrep.host.registry import Registries
@@ -67,6 +76,7 @@ __all__ = [
     "ClipStep",
     "ConvertStep",
     "FitStep",
+    "OperationStep",
     "Pipeline",
     "ReadStep",
     "ReprojectStep",
@@ -126,8 +136,10 @@ class ReprojectStep(StepOptions):
 
     kind: ClassVar[str] = "reproject"
 
-    to: str | int
-    source: str | int | None = Field(default=None, alias="from")
+    to: Annotated[str | int, Cli(flags=("--to",))]
+    """target CRS: EPSG:xxxx, WKT or PROJ string"""
+    source: Annotated[str | int | None, Cli(flags=("--from",))] = Field(default=None, alias="from")
+    """source CRS, when the file has none (or to override it)"""
 
     def check(self, registries: Registries) -> None:
         from geobrep.gis.crs_ops import crs_from_user_input
@@ -143,9 +155,27 @@ class ReprojectStep(StepOptions):
 class _CutStep(StepOptions):
     tolerance: NonNegativeFloat | None = None
     """On-plane distance (default: 1e-9 × the diagonal of the scene's bounding box)."""
-    options: dict[str, Options] = Field(default_factory=dict)
+    options: Annotated[
+        dict[str, Options],
+        Cli(
+            flags=("--option",),
+            append=True,
+            parse=key_value,
+            collect=as_nested_dict,
+            metavar="CLIPPER.KEY=VALUE",
+        ),
+    ] = Field(default_factory=dict)
     """Options per clipper name, e.g. ``{annotation: {precision: stroke}}``."""
-    clippers: dict[str, str] = Field(default_factory=dict)
+    clippers: Annotated[
+        dict[str, str],
+        Cli(
+            flags=("--clipper",),
+            append=True,
+            parse=key_value,
+            collect=as_dict,
+            metavar="TYPE=CLIPPER",
+        ),
+    ] = Field(default_factory=dict)
     """The clipper to use per entity type, when several are registered."""
 
     def check(self, registries: Registries) -> None:
@@ -167,8 +197,12 @@ class ClipStep(_CutStep):
 
     kind: ClassVar[str] = "clip"
 
-    plane: Plane4
+    plane: Annotated[
+        Plane4, Cli(group="plane", required=True, parse=comma_numbers(4), metavar="A,B,C,D")
+    ]
+    """The plane a·x + b·y + c·z + d = 0."""
     keep: Literal["negative", "positive"] = "negative"
+    """The side kept: negative (a·x+b·y+c·z+d < 0) or positive."""
 
 
 class ClipBoxStep(_CutStep):
@@ -199,7 +233,10 @@ class SectionStep(_CutStep):
 
     kind: ClassVar[str] = "section"
 
-    plane: Plane4
+    plane: Annotated[
+        Plane4, Cli(group="plane", required=True, parse=comma_numbers(4), metavar="A,B,C,D")
+    ]
+    """The plane a·x + b·y + c·z + d = 0."""
 
 
 class FitStep(StepOptions):
@@ -254,13 +291,24 @@ class VoxelizeStep(StepOptions):
     kind: ClassVar[str] = "voxelize"
 
     depth: int = Field(default=8, ge=0)
+    """finest level: 2**depth cells per axis (default 8)"""
     method: Literal["depth-buffer", "exact", "auto"] = "auto"
+    """depth buffers, all ray crossings, or auto (default: auto)"""
     fill_rule: Literal["parity", "nonzero"] = "parity"
-    bodies: tuple[str | int, ...] | None = None
-    origin: tuple[FiniteFloat, FiniteFloat, FiniteFloat] | None = None
+    """inside test of the exact mode (default: parity)"""
+    bodies: Annotated[tuple[str | int, ...] | None, Cli(parse=comma_items)] = None
+    """comma-separated names or ids of blocks/surfaces (default: every block)"""
+    origin: Annotated[
+        tuple[FiniteFloat, FiniteFloat, FiniteFloat] | None,
+        Cli(parse=comma_numbers(3), metavar="X,Y,Z"),
+    ] = None
+    """cube origin X,Y,Z (default: bounds)"""
     size: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+    """cube edge (default: largest extent)"""
     block_depth: int | None = Field(default=None, ge=0)
+    """process 8**N sub-cubes one at a time (default depth-8)"""
     name: str | None = None
+    """name of the octree (default: from the model's name)"""
 
     def builder_options(self) -> dict[str, Any]:
         """The options of the ``voxelize`` voxelizer."""
@@ -332,6 +380,43 @@ class ConvertStep(WriteStep):
     """The same as ``write``: ``convert: {format: vtu}`` reads naturally after ``read``."""
 
     kind: ClassVar[str] = "convert"
+
+
+class OperationStep(StepOptions):
+    """A step of an operation a plugin registered (``geobrep_register_operations``): written
+    ``NAME: {option: value, ...}`` like the built-in steps, its options validated by the
+    operation's own options model."""
+
+    operation: str
+    """The operation's step kind."""
+    options: Options = Field(default_factory=dict)
+    """The operation's options."""
+
+    @property
+    def kind(self) -> str:  # type: ignore[override]
+        """The step kind: the operation's."""
+        return self.operation
+
+    def check(self, registries: Registries) -> None:
+        _operation(registries, self.operation).validate_options(self.options)
+
+
+def _operation(registries: Registries, kind: str) -> Any:
+    spec = registries.operations.for_step(kind)
+    if spec is None or kind in _BY_KIND:
+        raise OptionsError(
+            f"no operation has the step kind {kind!r}; operations: "
+            + (", ".join(s.name for s in registries.operations) or "none registered")
+        )
+    return spec
+
+
+def plugin_step_kinds() -> list[str]:
+    """The step kinds of the operations plugins registered (beside :data:`STEP_KINDS`)."""
+    from geobrep.host import registries
+
+    kinds = (spec.step_kind for spec in registries().operations)
+    return [kind for kind in kinds if kind is not None and kind not in _BY_KIND]
 
 
 _STEP_TYPES: tuple[type[StepOptions], ...] = (
@@ -407,7 +492,13 @@ class ConvertEntry(_Entry):
     convert: ConvertStep
 
 
+class OperationEntry(_Entry):
+    operation: OperationStep
+
+
 def _step_tag(value: Any) -> str | None:
+    if isinstance(value, OperationEntry):
+        return "operation"
     if isinstance(value, Mapping) and len(value) == 1:
         return str(next(iter(value)))
     if isinstance(value, _Entry):
@@ -428,6 +519,7 @@ Step = Annotated[
         Annotated[VoxelizeEntry, Tag("voxelize")],
         Annotated[WriteEntry, Tag("write")],
         Annotated[ConvertEntry, Tag("convert")],
+        SkipJsonSchema[Annotated[OperationEntry, Tag("operation")]],
     ],
     Discriminator(_step_tag),
 ]
@@ -596,6 +688,8 @@ class Pipeline(BaseModel):
 
 def _shape(number: int, item: Any) -> Any:
     """Check that a step is ``{kind: body}``; bare ``kind`` strings and bodies are accepted."""
+    if isinstance(item, OperationStep):
+        return {"operation": item}
     if isinstance(item, StepOptions):
         return {item.kind: item}
     if isinstance(item, _Entry):
@@ -619,9 +713,13 @@ def _shape(number: int, item: Any) -> Any:
             f"step {number}: a step is a mapping with one key, its kind; got {keys}{hint}"
         )
     kind, body = next(iter(item.items()))
-    if kind not in _BY_KIND:
+    if kind not in _BY_KIND and kind != "operation":
+        plugins = plugin_step_kinds()
+        if kind in plugins:
+            return {"operation": {"operation": kind, "options": {} if body is None else body}}
         raise ValueError(
-            f"step {number}: unknown step kind {kind!r}; step kinds: {', '.join(STEP_KINDS)}"
+            f"step {number}: unknown step kind {kind!r}; step kinds: "
+            + ", ".join([*STEP_KINDS, *plugins])
         )
     return {kind: {} if body is None else body}
 

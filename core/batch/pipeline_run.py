@@ -38,6 +38,7 @@ from geobrep.batch.pipeline import (
     ClipStep,
     ConvertStep,
     FitStep,
+    OperationStep,
     Pipeline,
     ReadStep,
     ReprojectStep,
@@ -309,7 +310,7 @@ def run_file(pipeline: Pipeline, source: Path, targets: tuple[Path, ...]) -> Pip
         for work.number, body in numbered:
             work.kind = body.kind
             begun = time.perf_counter()
-            scene, notes = _APPLY[type(body)](body, scene, work)
+            scene, notes = _APPLY.get(type(body), _operation)(body, scene, work)
             reports.append(
                 StepReport(
                     step=work.number,
@@ -477,6 +478,16 @@ def _voxelize(step: VoxelizeStep, scene: Scene, work: _Work) -> Applied:
         raise GeobrepError(f"{spec.label} returned {type(octree).__name__}, not a LinearOctree")
     result = scene.with_entities(octree)
     return result, [f"octree: {octree.n_leaves} leaves, depth {octree.depth}"]
+
+
+def _operation(step: OperationStep, scene: Scene, work: _Work) -> Applied:
+    spec = work.registries.operations.for_step(step.operation)
+    if spec is None:  # checked before the run: the plugin went away meanwhile
+        raise OptionsError(f"no operation has the step kind {step.operation!r}")
+    result = spec.function(scene, spec.validate_options(step.options))
+    if not isinstance(result, Scene):
+        raise GeobrepError(f"{spec.label} returned {type(result).__name__}, not a Scene")
+    return result, []
 
 
 def _write(step: WriteStep, scene: Scene, work: _Work) -> Applied:

@@ -3,82 +3,106 @@
 The plane is ``--plane a,b,c,d`` (``a·x + b·y + c·z + d = 0``, negative side ``< 0``) or one of
 the shortcuts ``--x``, ``--y``, ``--z`` (the plane ``x = value``, etc.); ``--box
 xmin,xmax,ymin,ymax,zmin,zmax`` keeps the inside of a box instead. ``--keep both`` writes two files
-beside ``OUT``: ``NAME-negative.EXT`` and ``NAME-positive.EXT``.
+beside ``OUT``: ``NAME-negative.EXT`` and ``NAME-positive.EXT``. The other options are those of
+the ``clip`` operation (:class:`~geobrep.batch.pipeline.ClipStep`), ``--box`` those of ``clip_box``.
 """
 
 from __future__ import annotations
 
-import argparse
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal
 
-from geobrep.cli.common import (
-    add_allow_empty,
-    format_name,
-    is_empty,
-    read_input,
-    refuse_empty,
-    warn,
-)
+from pydantic import Field
+
+from geobrep.batch.pipeline import ClipBoxStep, ClipStep
+from geobrep.cli.common import is_empty, read_input, refuse_empty, warn
+from geobrep.cli.operation import SceneCommand
 from geobrep.errors import OptionsError
 from geobrep.geometry import Plane
+from geobrep.host.operations import Cli, comma_numbers, options_from_args
 
 __all__ = [
-    "add_parser",
-    "add_plane_arguments",
+    "COMMAND",
+    "DESCRIPTION",
+    "OPERATION",
+    "OPTIONS_FOR",
+    "ClipCommand",
+    "PlaneShortcuts",
     "both_paths",
-    "plane_from_args",
+    "clip_options",
     "plane_text",
     "run",
     "span_text",
 ]
 
-
-def _numbers(text: str, count: int, flag: str) -> list[float]:
-    try:
-        values = [float(part) for part in text.replace(" ", "").split(",")]
-    except ValueError:
-        raise OptionsError(
-            f"{flag}: expected {count} comma-separated numbers, got {text!r}"
-        ) from None
-    if len(values) != count:
-        raise OptionsError(f"{flag}: expected {count} comma-separated numbers, got {len(values)}")
-    return values
+OPERATION = "clip"
+DESCRIPTION = (
+    "Cut a model by a plane (keeping one side or both) or to a box; cut blocks "
+    "are closed again by caps. --keep both writes NAME-negative.EXT and NAME-positive.EXT."
+)
 
 
-def add_plane_arguments(parser: argparse.ArgumentParser, box: bool = False) -> None:
-    """The mutually exclusive ``--plane``/``--x``/``--y``/``--z`` (and ``--box``) options."""
-    group = parser.add_mutually_exclusive_group(required=True)
-    group.add_argument("--plane", metavar="A,B,C,D", help="the plane a·x + b·y + c·z + d = 0")
-    group.add_argument("--x", type=float, metavar="X", help="the plane x = X")
-    group.add_argument("--y", type=float, metavar="Y", help="the plane y = Y")
-    group.add_argument("--z", type=float, metavar="Z", help="the plane z = Z")
-    if box:
-        group.add_argument(
-            "--box", metavar="XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX", help="keep the inside of this box"
-        )
+class PlaneShortcuts(SceneCommand):
+    """``--x X``, ``--y Y``, ``--z Z``: the planes ``x = X``, ... (instead of ``--plane``)."""
+
+    x: Annotated[float | None, Cli(group="plane", metavar="X")] = None
+    """the plane x = X"""
+    y: Annotated[float | None, Cli(group="plane", metavar="Y")] = None
+    """the plane y = Y"""
+    z: Annotated[float | None, Cli(group="plane", metavar="Z")] = None
+    """the plane z = Z"""
+
+    def shortcut(self) -> Plane | None:
+        """The plane a shortcut names, if one was given."""
+        for axis in ("x", "y", "z"):
+            value = getattr(self, axis)
+            if value is not None:
+                return getattr(Plane, axis)(value)  # type: ignore[no-any-return]
+        return None
+
+    def operation_data(self) -> dict[str, Any]:
+        plane = self.shortcut()
+        return {} if plane is None else {"plane": plane.coefficients.tolist()}
 
 
-def plane_from_args(args: argparse.Namespace) -> Plane | None:
-    """The plane the arguments name (``None`` when ``--box`` was given)."""
-    if args.plane is not None:
-        return Plane(*_numbers(args.plane, 4, "--plane"))
-    for axis in ("x", "y", "z"):
-        value = getattr(args, axis)
-        if value is not None:
-            return getattr(Plane, axis)(value)  # type: ignore[no-any-return]
-    return None
+class ClipCommand(PlaneShortcuts):
+    """The files and command-line-only options of ``geobrep clip``."""
+
+    box: Annotated[
+        tuple[float, float, float, float, float, float] | None,
+        Cli(group="plane", parse=comma_numbers(6), metavar="XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX"),
+    ] = None
+    """keep the inside of this box"""
+    keep: Literal["negative", "positive", "both"] = Field(default="negative")
+    """side to keep: negative (a·x+b·y+c·z+d < 0, the default), positive, or both"""
 
 
-def plane_text(args: argparse.Namespace) -> str:
+def clip_options(command: Any, given: Mapping[str, Any]) -> ClipStep | ClipBoxStep:
+    """The options of ``clip`` (or of ``clip_box`` for ``--box``) the arguments give."""
+    if getattr(command, "box", None) is not None:
+        if command.keep != "negative":
+            raise OptionsError("--box keeps the inside of the box: --keep does not apply")
+        data = {key: value for key, value in given.items() if key != "plane"}
+        return options_from_args(ClipBoxStep, {**data, "bounds": command.box})  # type: ignore[no-any-return]
+    data = {**given, **command.operation_data()}
+    data.pop("keep", None)
+    if command.keep != "both":
+        data["keep"] = command.keep
+    return options_from_args(ClipStep, data)  # type: ignore[no-any-return]
+
+
+def plane_text(args: PlaneShortcuts, options: Any = None) -> str:
     """The plane or box as the user gave it, for messages: ``the plane x = 1e+09``."""
-    if args.plane is not None:
-        return f"the plane {args.plane} (a,b,c,d)"
     for axis in ("x", "y", "z"):
         value = getattr(args, axis)
         if value is not None:
             return f"the plane {axis} = {value:g}"
-    return f"the box {getattr(args, 'box', '')}"
+    box = getattr(args, "box", None)
+    if box is not None:
+        return f"the box {','.join(f'{v:g}' for v in box)}"
+    plane = getattr(options, "plane", None)
+    return f"the plane {','.join(f'{v:g}' for v in plane or ())} (a,b,c,d)"
 
 
 def span_text(scene: Any) -> str:
@@ -118,31 +142,6 @@ def both_paths(output: Path) -> tuple[Path, Path]:
     )
 
 
-def add_parser(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "clip",
-        help="cut a model by a plane or to a box",
-        description="Cut a model by a plane (keeping one side or both) or to a box; cut blocks "
-        "are closed again by caps. --keep both writes NAME-negative.EXT and NAME-positive.EXT.",
-    )
-    parser.add_argument("input", help="model to cut (any readable format)")
-    parser.add_argument("output", help="file to write (its extension picks the format)")
-    add_plane_arguments(parser, box=True)
-    parser.add_argument(
-        "--keep",
-        choices=("negative", "positive", "both"),
-        default="negative",
-        help="side to keep: negative (a·x+b·y+c·z+d < 0, the default), positive, or both",
-    )
-    parser.add_argument("--tolerance", type=float, help="on-plane distance (model units)")
-    parser.add_argument(
-        "--format", type=format_name("read"), help="input format, when the extension is not enough"
-    )
-    parser.add_argument("--output-format", type=format_name("write"), help="output format name")
-    add_allow_empty(parser)
-    parser.set_defaults(run=run)
-
-
 def _describe(scene: Any) -> str:
     caps = [s for s in scene.surfaces if s.kind == "cap"]
     return (
@@ -151,29 +150,34 @@ def _describe(scene: Any) -> str:
     )
 
 
-def run(args: argparse.Namespace) -> int:
+def run(options: ClipStep | ClipBoxStep, args: ClipCommand) -> int:
     from geobrep.ops.clipping import clip, clip_box
     from geobrep.ops.io import as_scene, write
 
     scene = read_input(args, args.input, format=args.format)
     output = Path(args.output)
-    plane = plane_from_args(args)
+    cut: dict[str, Any] = {
+        "tolerance": options.tolerance,
+        "options": options.options,
+        "clippers": options.clippers,
+    }
     results: list[tuple[Path, Any, str]] = []
-    if plane is None:
-        if args.keep != "negative":
-            raise OptionsError("--box keeps the inside of the box: --keep does not apply")
-        result = clip_box(scene, _numbers(args.box, 6, "--box"), tolerance=args.tolerance)
+    plane = None
+    if isinstance(options, ClipBoxStep):
+        result = clip_box(scene, list(options.bounds or ()), **cut)
         results.append((output, as_scene(result if result is not None else []), "inside of"))
-    elif args.keep == "both":
-        negative, positive = clip(scene, plane, keep="both", tolerance=args.tolerance)
-        for path, part, side in zip(
-            both_paths(output), (negative, positive), ("negative", "positive"), strict=True
-        ):
-            results.append((path, part, f"{side} side of"))
     else:
-        kept = clip(scene, plane, keep=args.keep, tolerance=args.tolerance)
-        results.append((output, kept, f"{args.keep} side of"))
-    where = f"{plane_text(args)} ({span_text(scene)})"
+        plane = Plane(*options.plane)
+        if args.keep == "both":
+            negative, positive = clip(scene, plane, keep="both", **cut)
+            for path, part, side in zip(
+                both_paths(output), (negative, positive), ("negative", "positive"), strict=True
+            ):
+                results.append((path, part, f"{side} side of"))
+        else:
+            kept = clip(scene, plane, keep=options.keep, **cut)
+            results.append((output, kept, f"{options.keep} side of"))
+    where = f"{plane_text(args, options)} ({span_text(scene)})"
     refuse_empty(
         args,
         [
@@ -184,8 +188,12 @@ def run(args: argparse.Namespace) -> int:
         consequence="no file written",
     )
     if plane is not None and args.keep != "both" and _misses(plane, scene):
-        warn(f"{output}: {plane_text(args)} does not meet the model ({span_text(scene)})")
+        warn(f"{output}: {plane_text(args, options)} does not meet the model ({span_text(scene)})")
     for path, part, _ in results:
         write(part, path, format=args.output_format)
         print(f"{path}: {_describe(part)}")
     return 0
+
+
+COMMAND = ClipCommand
+OPTIONS_FOR = clip_options

@@ -339,7 +339,7 @@ def is_empty(data: Scene | Entity | Iterable[Entity] | None) -> bool:
 
 
 def refuse_empty(
-    args: argparse.Namespace, messages: Sequence[str], consequence: str | None = None
+    args: argparse.Namespace | Any, messages: Sequence[str], consequence: str | None = None
 ) -> None:
     """Each message (one empty result) is a warning; without ``--allow-empty`` a failure.
 
@@ -356,7 +356,9 @@ def refuse_empty(
     raise EmptyResultError([f"{message}{tail} (--allow-empty accepts it)" for message in messages])
 
 
-def read_input(args: argparse.Namespace, path: str | Path, format: str | None = None) -> Scene:
+def read_input(
+    args: argparse.Namespace | Any, path: str | Path, format: str | None = None
+) -> Scene:
     """Read a command's input; a file with nothing in it is refused (:func:`refuse_empty`)."""
     from geobrep.ops.io import read
 

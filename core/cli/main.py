@@ -9,6 +9,7 @@ import sys
 import traceback
 from collections.abc import Sequence
 from types import ModuleType
+from typing import Any
 
 from geobrep.cli.common import EXIT_EMPTY, CliParser, EmptyResultError, WarningLines, add_verbosity
 from geobrep.errors import GeobrepError
@@ -17,7 +18,10 @@ __all__ = ["build_parser", "main"]
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 70, 130
 
-#: Subcommand modules of ``geobrep.cli``, each with ``add_parser(subparsers)``, in help order.
+#: Subcommand modules of ``geobrep.cli``, in help order: a command's module has
+#: ``add_parser(subparsers)``; an operation's has ``OPERATION`` (its name), ``run(options,
+#: command)`` and optionally its command model (a class named ``...Command``), ``DESCRIPTION``
+#: and ``clip_options``-like ``OPTIONS_FOR``; its parser is derived from the declarations.
 COMMAND_MODULES = (
     "info",
     "plugins",
@@ -50,11 +54,36 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"geobrep {__version__}")
     add_verbosity(parser, top_level=True)
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for command in _command_modules():
-        command.add_parser(subparsers)
+    _add_commands(subparsers)
     for subparser in {id(p): p for p in subparsers.choices.values()}.values():
         add_verbosity(subparser)
     return parser
+
+
+def _add_commands(subparsers: Any) -> None:
+    """Every command: the modules', then the operations of plugins that have none."""
+    from geobrep.batch.operations import operations
+    from geobrep.cli.operation import SceneCommand, add_operation_parser, run_scene_operation
+
+    registry = operations()
+    for module in _command_modules():
+        if hasattr(module, "add_parser"):
+            module.add_parser(subparsers)
+            continue
+        spec = registry.get(module.OPERATION)
+        add_operation_parser(
+            subparsers,
+            spec,
+            module.run,
+            command=getattr(module, "COMMAND", SceneCommand),
+            description=getattr(module, "DESCRIPTION", None),
+            options_for=getattr(module, "OPTIONS_FOR", None),
+        )
+    for spec in registry:
+        name = spec.command_name
+        if spec.builtin or name is None or name in subparsers.choices:
+            continue
+        add_operation_parser(subparsers, spec, run_scene_operation(spec))
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -68,7 +97,12 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(argv: Sequence[str] | None, lines: WarningLines) -> int:
-    parser = build_parser()
+    try:
+        parser = build_parser()  # loads the plugins: their operations are commands
+    except GeobrepError as exc:
+        lines.flush()
+        print(f"geobrep: error: {exc}", file=sys.stderr)
+        return EXIT_ERROR
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse: --help/--version (0) or a usage error (2)

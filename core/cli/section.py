@@ -1,57 +1,53 @@
-"""``geobrep section IN OUT --plane ...``: the cut itself — block section polygons and traces."""
+"""``geobrep section IN OUT --plane ...``: the cut itself — block section polygons and traces.
+
+The options are those of the ``section`` operation (:class:`~geobrep.batch.pipeline.SectionStep`);
+``--x``, ``--y`` and ``--z`` (:class:`~geobrep.cli.clip.PlaneShortcuts`) name its plane too.
+"""
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
-from geobrep.cli.clip import add_plane_arguments, plane_from_args, plane_text, span_text
-from geobrep.cli.common import add_allow_empty, format_name, is_empty, read_input, refuse_empty
-from geobrep.errors import OptionsError
+from geobrep.batch.pipeline import SectionStep
+from geobrep.cli.clip import PlaneShortcuts, plane_text, span_text
+from geobrep.cli.common import is_empty, read_input, refuse_empty
+from geobrep.geometry import Plane
 
-__all__ = ["add_parser", "run"]
+__all__ = ["COMMAND", "DESCRIPTION", "OPERATION", "SectionCommand", "run"]
 
-
-def add_parser(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "section",
-        help="section polygons of blocks and traces of surfaces on a plane",
-        description="Write the section of a model by a plane: one polygon (with holes) per cut "
-        "block, carrying the block's id and attributes, and the trace of every cut surface.",
-    )
-    parser.add_argument("input", help="model to cut (any readable format)")
-    parser.add_argument("output", help="file to write (its extension picks the format)")
-    add_plane_arguments(parser)
-    parser.add_argument("--tolerance", type=float, help="on-plane distance (model units)")
-    parser.add_argument(
-        "--format", type=format_name("read"), help="input format, when the extension is not enough"
-    )
-    parser.add_argument("--output-format", type=format_name("write"), help="output format name")
-    parser.add_argument(
-        "--coordinates",
-        choices=("auto", "world", "plane", "both"),
-        default="auto",
-        help="where the section of a plane that is not horizontal goes: 'world' (map "
-        "coordinates: a vertical section has no area in map view), 'plane' (distance along the "
-        "section line and elevation, in *_plane layers: valid polygons a GIS can draw), 'both'; "
-        "'auto' (default): both for a GeoPackage, world otherwise",
-    )
-    add_allow_empty(parser)
-    parser.set_defaults(run=run)
+OPERATION = "section"
+DESCRIPTION = (
+    "Write the section of a model by a plane: one polygon (with holes) per cut "
+    "block, carrying the block's id and attributes, and the trace of every cut surface."
+)
 
 
-def run(args: argparse.Namespace) -> int:
+class SectionCommand(PlaneShortcuts):
+    """The files and command-line-only options of ``geobrep section``."""
+
+    coordinates: Literal["auto", "world", "plane", "both"] = "auto"
+    """where the section of a plane that is not horizontal goes: 'world' (map coordinates: a
+    vertical section has no area in map view), 'plane' (distance along the section line and
+    elevation, in *_plane layers: valid polygons a GIS can draw), 'both'; 'auto' (default):
+    both for a GeoPackage, world otherwise"""
+
+
+def run(options: SectionStep, args: SectionCommand) -> int:
     from geobrep.ops.clipping import section
     from geobrep.ops.io import write
 
     scene = read_input(args, args.input, format=args.format)
-    plane = plane_from_args(args)
-    if plane is None:  # pragma: no cover - argparse requires one plane option
-        raise OptionsError("give --plane, --x, --y or --z")
-    panel = section(scene, plane, tolerance=args.tolerance)
+    plane = Plane(*options.plane)
+    panel = section(
+        scene,
+        plane,
+        tolerance=options.tolerance,
+        options=options.options,
+        clippers=options.clippers,
+    )
     if is_empty(panel):
-        message = f"{args.output}: {plane_text(args)} touches nothing ({span_text(scene)})"
+        message = f"{args.output}: {plane_text(args, options)} touches nothing ({span_text(scene)})"
         refuse_empty(args, [message], consequence="no file written")
     polygons = sum(1 for e in panel.entities if e.kind == "section")
     traces = len(panel.entities) - polygons
@@ -62,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _coordinates(args: argparse.Namespace) -> str:
+def _coordinates(args: SectionCommand) -> str:
     if args.coordinates != "auto":
         return str(args.coordinates)
     gpkg = args.output_format == "gpkg" or (
@@ -94,3 +90,6 @@ def _in_coordinates(panel: Any, plane: Any, coordinates: str) -> tuple[Any, bool
     moved = to_section_plane(layered, section_frame(plane, vertices))
     kept = layered if coordinates == "both" else []
     return panel.replace(entities=[*kept, *moved], topology={}), True
+
+
+COMMAND = SectionCommand

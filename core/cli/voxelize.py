@@ -1,87 +1,39 @@
-"""``geobrep voxelize IN OUT --depth 8``: the linear octree of a model's closed bodies."""
+"""``geobrep voxelize IN OUT --depth 8``: the linear octree of a model's closed bodies.
+
+The options are those of the ``voxelize`` operation (:class:`~geobrep.batch.pipeline.VoxelizeStep`,
+the pipeline step's body); the parser is derived from it and :class:`VoxelizeCommand`.
+"""
 
 from __future__ import annotations
 
-import argparse
 import json
 import time
-from typing import Any
+from typing import Annotated
 
-from geobrep.cli.common import (
-    add_allow_empty,
-    format_name,
-    read_input,
-    recorded_warnings,
-    refuse_empty,
+from geobrep.batch.pipeline import VoxelizeStep
+from geobrep.cli.common import read_input, recorded_warnings, refuse_empty
+from geobrep.cli.operation import SceneCommand
+from geobrep.host.operations import Cli
+
+__all__ = ["COMMAND", "DESCRIPTION", "OPERATION", "VoxelizeCommand", "run"]
+
+OPERATION = "voxelize"
+DESCRIPTION = (
+    "Voxelize every block of IN (or the closed surfaces of a model without blocks) into "
+    "one linear octree (Morton codes, levels, block labels) and write it to OUT."
 )
 
-__all__ = ["add_parser", "run"]
+
+class VoxelizeCommand(SceneCommand):
+    """The files and the command-line-only options of ``geobrep voxelize``."""
+
+    keep_input: bool = False
+    """also write the input model"""
+    as_json: Annotated[bool, Cli(flags=("--json",))] = False
+    """print the report as JSON"""
 
 
-def _bodies(text: str) -> list[str | int]:
-    items: list[str | int] = []
-    for part in text.split(","):
-        part = part.strip()
-        if part:
-            items.append(int(part) if part.isdigit() else part)
-    return items
-
-
-def _origin(text: str) -> tuple[float, float, float]:
-    try:
-        values = tuple(float(v) for v in text.split(","))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected X,Y,Z numbers, got {text!r}") from None
-    if len(values) != 3:
-        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}")
-    return values[0], values[1], values[2]
-
-
-def add_parser(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "voxelize",
-        help="linear octree of the closed bodies of a model",
-        description=(
-            "Voxelize every block of IN (or the closed surfaces of a model without blocks) into "
-            "one linear octree (Morton codes, levels, block labels) and write it to OUT."
-        ),
-    )
-    parser.add_argument("input", metavar="IN", help="model to voxelize (any readable format)")
-    parser.add_argument("output", metavar="OUT", help="output file, e.g. octree.geobrep")
-    parser.add_argument(
-        "--depth", type=int, default=8, help="finest level: 2**depth cells per axis (default 8)"
-    )
-    parser.add_argument(
-        "--method",
-        choices=("auto", "depth-buffer", "exact"),
-        default="auto",
-        help="depth buffers, all ray crossings, or auto (default: auto)",
-    )
-    parser.add_argument(
-        "--fill-rule",
-        choices=("parity", "nonzero"),
-        default="parity",
-        help="inside test of the exact mode (default: parity)",
-    )
-    parser.add_argument(
-        "--bodies", type=_bodies, help="comma-separated names or ids of blocks/surfaces"
-    )
-    parser.add_argument("--origin", type=_origin, help="cube origin X,Y,Z (default: bounds)")
-    parser.add_argument("--size", type=float, help="cube edge (default: largest extent)")
-    parser.add_argument(
-        "--block-depth", type=int, help="process 8**N sub-cubes one at a time (default depth-8)"
-    )
-    parser.add_argument("--keep-input", action="store_true", help="also write the input model")
-    parser.add_argument(
-        "--format", type=format_name("read"), help="input format, when the extension is not enough"
-    )
-    parser.add_argument("--output-format", type=format_name("write"), help="output format name")
-    parser.add_argument("--json", action="store_true", help="print the report as JSON")
-    add_allow_empty(parser)
-    parser.set_defaults(run=run)
-
-
-def run(args: argparse.Namespace) -> int:
+def run(options: VoxelizeStep, args: VoxelizeCommand) -> int:
     from geobrep.model.scene import Scene
     from geobrep.ops.io import write
     from geobrep.ops.voxelization import voxelize
@@ -89,16 +41,7 @@ def run(args: argparse.Namespace) -> int:
     scene = read_input(args, args.input, format=args.format)
     start = time.perf_counter()
     with recorded_warnings() as caught:
-        tree = voxelize(
-            scene,
-            depth=args.depth,
-            method=args.method,
-            fill_rule=args.fill_rule,
-            bodies=args.bodies,
-            origin=args.origin,
-            size=args.size,
-            block_depth=args.block_depth,
-        )
+        tree = voxelize(scene, **options.builder_options())
     elapsed = time.perf_counter() - start
     if tree.n_leaves == 0:
         refuse_empty(args, [f"{args.output}: the octree has no leaf"], consequence="not written")
@@ -124,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
         "bodies": report["bodies"],
         "warnings": [str(w.message) for w in caught],
     }
-    if args.json:
+    if args.as_json:
         print(json.dumps(summary, indent=2))
         return 0
     print(
@@ -153,3 +96,6 @@ def run(args: argparse.Namespace) -> int:
         f"of one byte per cell ({tree.memory_bytes / full_grid:.1%})"
     )
     return 0
+
+
+COMMAND = VoxelizeCommand

@@ -77,6 +77,7 @@ HOOK_KINDS: dict[str, str] = {
     "geobrep_register_builders": "builders",
     "geobrep_register_voxelizers": "voxelizers",
     "geobrep_register_checks": "checks",
+    "geobrep_register_operations": "operations",
 }
 """Each hook and the :class:`~geobrep.host.registry.Registries` field it fills."""
 

@@ -42,6 +42,7 @@ from geobrep.host._isolation import (
 
 if TYPE_CHECKING:
     from geobrep.geometry import Plane
+    from geobrep.host.operations import OperationRegistry
     from geobrep.model.entities import Entity, LinearOctree
     from geobrep.model.scene import Scene
 
@@ -853,6 +854,7 @@ class Registries:
     builders: BuilderRegistry = field(default_factory=BuilderRegistry)
     voxelizers: VoxelizerRegistry = field(default_factory=VoxelizerRegistry)
     checks: CheckRegistry = field(default_factory=CheckRegistry)
+    operations: OperationRegistry = field(default_factory=lambda: _operation_registry())
 
     KINDS: ClassVar[tuple[str, ...]] = (
         "formats",
@@ -861,6 +863,7 @@ class Registries:
         "builders",
         "voxelizers",
         "checks",
+        "operations",
     )
 
     @classmethod
@@ -873,8 +876,15 @@ class Registries:
             builders=BuilderRegistry(plugin=plugin, builtin=builtin),
             voxelizers=VoxelizerRegistry(plugin=plugin, builtin=builtin),
             checks=CheckRegistry(plugin=plugin, builtin=builtin),
+            operations=_operation_registry(plugin=plugin, builtin=builtin),
         )
 
     def by_kind(self) -> dict[str, Registry[Any]]:
         """``{"formats": ..., "clippers": ..., ...}``."""
         return {kind: getattr(self, kind) for kind in self.KINDS}
+
+
+def _operation_registry(plugin: str | None = None, builtin: bool = False) -> OperationRegistry:
+    from geobrep.host.operations import OperationRegistry  # it builds on this module
+
+    return OperationRegistry(plugin=plugin, builtin=builtin)

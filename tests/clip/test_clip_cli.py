@@ -54,7 +54,7 @@ def test_section(model: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 
 def test_bad_arguments(model: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "x.geobrep"
-    assert main(["clip", str(model), str(out), "--plane", "1,2"]) == 1
+    assert main(["clip", str(model), str(out), "--plane", "1,2"]) == 2  # a malformed value
     assert "--plane: expected 4" in capsys.readouterr().err
     assert main(["clip", str(model), str(out)]) == 2  # a plane option is required
     assert main(["clip", str(tmp_path / "missing.geobrep"), str(out), "--x", "1"]) == 1

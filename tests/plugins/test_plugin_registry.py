@@ -224,7 +224,14 @@ def test_registry_rejects_items_of_the_wrong_kind() -> None:
 
 def test_registries_container() -> None:
     registries = Registries()
-    assert set(registries.by_kind()) == {"formats", "clippers", "fitters", "builders", "voxelizers"}
+    assert set(registries.by_kind()) == {
+        "formats",
+        "clippers",
+        "fitters",
+        "builders",
+        "voxelizers",
+        "operations",
+    }
     assert registries.by_kind()["formats"] is registries.formats
     with pytest.raises(AttributeError):
         registries.formats = FormatRegistry()  # type: ignore[misc]

@@ -1,4 +1,4 @@
-"""Example geobrep plugin: registers the XYZ point format (``x y z [value]`` per line).
+"""Example geobrep plugin: the XYZ point format (``x y z [value]`` per line) and ``thin``.
 
 Installed, it is found through its entry point (see ``pyproject.toml``)::
 
@@ -11,12 +11,23 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from geobrep.plugins import FormatCapabilities, FormatSpec, hookimpl
+from geobrep_example_plugin.thin import THIN, ThinOptions, thin
 from geobrep_example_plugin.xyz import XyzOptions, looks_like_xyz, read_xyz, write_xyz
 
 if TYPE_CHECKING:
-    from geobrep.plugins import FormatRegistry
+    from geobrep.plugins import FormatRegistry, OperationRegistry
 
-__all__ = ["XyzOptions", "geobrep_register_formats", "looks_like_xyz", "read_xyz", "write_xyz"]
+__all__ = [
+    "THIN",
+    "ThinOptions",
+    "XyzOptions",
+    "geobrep_register_formats",
+    "geobrep_register_operations",
+    "looks_like_xyz",
+    "read_xyz",
+    "thin",
+    "write_xyz",
+]
 
 __version__ = "0.1.0"
 
@@ -36,3 +47,9 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
             capabilities=FormatCapabilities(entity_types=frozenset({"PointSet"}), point_data=True),
         )
     )
+
+
+@hookimpl
+def geobrep_register_operations(registry: OperationRegistry) -> None:
+    """Register the ``thin`` operation (a command, a pipeline step and a Python function)."""
+    registry.add(THIN)

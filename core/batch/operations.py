@@ -1,0 +1,189 @@
+"""geobrep's own operations, declared like a plugin's, and the registry of all of them.
+
+Each built-in operation is an :class:`~geobrep.host.operations.OperationSpec` whose options
+model is its pipeline step (:mod:`geobrep.batch.pipeline`) and whose function is the public
+function of a Scene (:func:`geobrep.clip`, :func:`geobrep.voxelize`, ...). :func:`operations`
+is every operation: these first, then the ones plugins registered
+(``geobrep_register_operations``); a plugin's operation may not take a built-in name.
+
+>>> [spec.name for spec in builtin_operations()][:3]
+['reproject', 'clip', 'clip_box']
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from geobrep.batch.pipeline import (
+    BuildBlocksStep,
+    BuildStep,
+    ClipBoxStep,
+    ClipStep,
+    FitStep,
+    ReprojectStep,
+    SectionStep,
+    VoxelizeStep,
+)
+from geobrep.errors import EntityNotFoundError
+from geobrep.host.operations import OperationRegistry, OperationSpec
+from geobrep.model.entities import Entity, PointSet, PolyLine
+from geobrep.model.scene import Scene
+
+__all__ = ["builtin_operations", "operations"]
+
+
+def _scene(result: Any, scene: Scene) -> Scene:
+    """A clip that left nothing is an empty scene with the input's CRS and name."""
+    if isinstance(result, Scene):
+        return result
+    return Scene(crs=scene.crs, name=scene.name, metadata=scene.metadata)
+
+
+def _cut(step: ClipStep | ClipBoxStep | SectionStep) -> dict[str, Any]:
+    return {"tolerance": step.tolerance, "options": step.options, "clippers": step.clippers}
+
+
+def _reproject(scene: Scene, step: ReprojectStep) -> Scene:
+    return scene.to_crs(step.to, source=step.source)
+
+
+def _clip(scene: Scene, step: ClipStep) -> Scene:
+    from geobrep.ops.clipping import clip
+
+    return _scene(clip(scene, step.plane, step.keep, **_cut(step)), scene)
+
+
+def _clip_box(scene: Scene, step: ClipBoxStep) -> Scene:
+    from geobrep.ops.clipping import clip_box
+
+    region: Any = step.bounds if step.bounds is not None else step.planes
+    return _scene(clip_box(scene, region, **_cut(step)), scene)
+
+
+def _section(scene: Scene, step: SectionStep) -> Scene:
+    from geobrep.ops.clipping import section
+
+    return _scene(section(scene, step.plane, **_cut(step)), scene)
+
+
+def fit_points(scene: Scene, step: FitStep) -> Scene:
+    """The surfaces fitted to the scene's PointSets (or the entities ``step.points`` names)."""
+    from geobrep.ops.fitting import fit
+
+    points: list[PointSet | PolyLine]
+    if step.points is None:
+        points = list(scene.point_sets)
+        if not points:
+            raise EntityNotFoundError("the scene holds no PointSet to fit")
+    else:
+        points = []
+        for name in step.points:
+            found = [e for e in scene.find(name) if isinstance(e, PointSet | PolyLine)]
+            if not found:
+                raise EntityNotFoundError(f"no PointSet or PolyLine named {name!r} to fit")
+            points.extend(found)
+    surfaces: list[Entity] = [
+        fit(entity, method=step.method, **step.options).surface.model_copy(update={"id": None})
+        for entity in points
+    ]
+    if step.keep_input:
+        return scene.with_entities(*surfaces)
+    return Scene(entities=surfaces, crs=scene.crs, name=scene.name)
+
+
+def _build_blocks(scene: Scene, step: BuildBlocksStep) -> Scene:
+    from geobrep.ops.building import build_blocks
+
+    return build_blocks(scene, step.builder, **step.options)
+
+
+def _voxelize(scene: Scene, step: VoxelizeStep) -> Scene:
+    from geobrep.ops.voxelization import voxelize
+
+    return scene.with_entities(voxelize(scene, **step.builder_options()))
+
+
+def builtin_operations() -> list[OperationSpec]:
+    """geobrep's own operations, in the order the documentation presents them."""
+    return [
+        OperationSpec(
+            name="reproject",
+            summary="transform a model into another CRS",
+            options=ReprojectStep,
+            function=_reproject,
+            writes="every entity in the target CRS",
+        ),
+        OperationSpec(
+            name="clip",
+            summary="cut a model by a plane or to a box",
+            options=ClipStep,
+            function=_clip,
+            writes="the side kept; cut blocks closed by caps",
+        ),
+        OperationSpec(
+            name="clip_box",
+            summary="keep the inside of a box or of convex planes",
+            options=ClipBoxStep,
+            function=_clip_box,
+            command=None,  # `geobrep clip --box`
+            writes="the inside of the box",
+        ),
+        OperationSpec(
+            name="section",
+            summary="section polygons of blocks and traces of surfaces on a plane",
+            options=SectionStep,
+            function=_section,
+            writes="one polygon per cut block, one trace per cut surface",
+        ),
+        OperationSpec(
+            name="fit",
+            summary="fit a surface to points (skinning, approximation, kriging, hybrid)",
+            options=FitStep,
+            function=fit_points,
+            writes="the fitted surfaces (and the input with keep_input)",
+        ),
+        OperationSpec(
+            name="build_blocks",
+            summary="build blocks from conformal surfaces",
+            options=BuildBlocksStep,
+            function=_build_blocks,
+            command="blocks",
+            writes="the surfaces with their blocks, patches, arcs and corners",
+        ),
+        OperationSpec(
+            name="build",
+            summary="run any registered builder",
+            options=BuildStep,
+            function=_build_blocks,
+            command=None,
+            writes="what the builder returns",
+        ),
+        OperationSpec(
+            name="voxelize",
+            summary="linear octree of the closed bodies of a model",
+            options=VoxelizeStep,
+            function=_voxelize,
+            writes="the scene with its linear octree appended",
+        ),
+    ]
+
+
+def operations() -> OperationRegistry:
+    """Every operation: geobrep's own, then those of the loaded plugins.
+
+    >>> spec = operations().get("voxelize")
+    >>> spec.command_name, spec.step_kind
+    ('voxelize', 'voxelize')
+    """
+    from geobrep.host import registries
+
+    registry = OperationRegistry()
+    for spec in builtin_operations():
+        registry.add(spec.model_copy(update={"plugin": "geobrep", "builtin": True}))
+    for spec in registries().operations:
+        taken = spec.name in registry or (
+            spec.step_kind is not None and registry.for_step(spec.step_kind) is not None
+        )
+        if not taken:  # a plugin cannot replace a built-in operation
+            registry.add(spec)
+    return registry

@@ -1,0 +1,85 @@
+"""Every built-in operation agrees with itself: its function's options, its command's flags, its
+pipeline step's JSON Schema and its documentation are one set of names (one declaration)."""
+
+from __future__ import annotations
+
+import inspect
+import re
+from pathlib import Path
+
+import pytest
+
+import geobrep
+import geobrep.schemas
+from geobrep.batch.operations import builtin_operations
+from geobrep.batch.pipeline import option_names
+from geobrep.cli.main import build_parser
+from geobrep.host.operations import cli_flags
+
+DOCS = Path(__file__).resolve().parent.parent / "docs"
+SPECS = {spec.name: spec for spec in builtin_operations()}
+
+#: The public function of each operation, and the keys of its step it takes under another name.
+FUNCTIONS = {
+    "reproject": (geobrep.Scene.to_crs, {"to": "target", "from": "source"}),
+    "clip": (geobrep.clip, {}),
+    "clip_box": (geobrep.clip_box, {"planes": "bounds"}),
+    "section": (geobrep.section, {}),
+    "fit": (geobrep.fit, {}),
+    "build_blocks": (geobrep.build_blocks, {}),
+    "build": (geobrep.build_blocks, {}),
+    "voxelize": (geobrep.voxelize, {}),
+}
+#: Keys that say what a step does with the scene, not how the function works.
+STEP_ONLY = {"fit": {"points", "keep_input", "check", "max_triangles"}}
+#: Commands whose parser is derived from the declaration (the rest are listed in the report).
+DERIVED = {"reproject", "clip", "section", "voxelize"}
+
+
+def test_every_operation_has_a_function() -> None:
+    assert set(FUNCTIONS) == set(SPECS)
+
+
+@pytest.mark.parametrize("name", sorted(SPECS))
+def test_function_takes_every_option(name: str) -> None:
+    function, renamed = FUNCTIONS[name]
+    parameters = inspect.signature(function).parameters
+    forwards = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters.values())
+    for key in option_names(SPECS[name].options):
+        if key in STEP_ONLY.get(name, set()):
+            continue
+        if key == "options" and forwards:
+            continue  # the plugin's options, passed on as keywords
+        assert renamed.get(key, key) in parameters, f"{name}: the function lacks {key!r}"
+
+
+@pytest.mark.parametrize("name", sorted(SPECS))
+def test_step_schema_has_every_option(name: str) -> None:
+    schema = geobrep.schemas.load("pipeline")["$defs"][SPECS[name].options.__name__]
+    assert sorted(schema["properties"]) == sorted(option_names(SPECS[name].options))
+
+
+@pytest.mark.parametrize("name", sorted(DERIVED))
+def test_command_has_a_flag_for_every_option(name: str) -> None:
+    spec = SPECS[name]
+    parser = build_parser()
+    command = parser._subparsers._group_actions[0].choices[spec.command_name]  # type: ignore[union-attr]
+    flags = {option for action in command._actions for option in action.option_strings}
+    for field, info in spec.options.model_fields.items():
+        for flag in cli_flags(field, info):
+            assert flag in flags, f"geobrep {spec.command_name} lacks {flag}"
+
+
+@pytest.mark.parametrize("name", sorted(SPECS))
+def test_docs_name_every_option(name: str) -> None:
+    text = (DOCS / "pipelines.md").read_text(encoding="utf-8")
+    paragraph = re.search(rf"^\*\*`{name}`\*\*.*?(?=^\*\*`|^## )", text, re.M | re.S)
+    assert paragraph is not None, f"docs/pipelines.md has no paragraph for {name!r}"
+    inherited = re.findall(r"`(\w+)`(?:, `\w+`)* as for `(\w+)`", paragraph.group(0))
+    named = set(re.findall(r"`(\w+)`", paragraph.group(0)))
+    for _, other in inherited:
+        block = re.search(rf"^\*\*`{other}`\*\*.*?(?=^\*\*`|^## )", text, re.M | re.S)
+        assert block is not None
+        named |= set(re.findall(r"`(\w+)`", block.group(0)))
+    missing = [key for key in option_names(SPECS[name].options) if key not in named]
+    assert not missing, f"docs/pipelines.md, step {name!r}, does not describe {missing}"
