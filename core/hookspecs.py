@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 import pluggy
 
 if TYPE_CHECKING:
+    from geobrep.host.operations import OperationRegistry
     from geobrep.host.registry import (
         BuilderRegistry,
         CheckRegistry,
@@ -30,7 +31,6 @@ if TYPE_CHECKING:
         FormatRegistry,
         VoxelizerRegistry,
     )
-    from geobrep.host.operations import OperationRegistry
 
 __all__ = ["PROJECT_NAME", "GeobrepSpecs", "hookimpl", "hookspec"]
 

@@ -17,12 +17,12 @@ and implementing any of the hooks of :mod:`geobrep.hookspecs`::
 Everything a plugin needs is importable from here: the :data:`hookimpl` marker, the spec and
 registry types (``FormatSpec``, ``ClipperSpec``, ``FitterSpec``, ``BuilderSpec``,
 ``VoxelizerSpec``, ``CheckSpec``, ``OperationSpec`` and its ``Cli`` marker, ...) and the
-Protocols their callables follow (``Reader``, ``Writer``, ``ClipFunction``, ``FitFunction``, ...), the clipping context (``ClipContext``,
-``SceneDraft``, ``halves``, ``pack_halves``), the fit result types (``FitResult``, ``FitReport``),
-``atomic_write``, the topology helpers (``chain_arc_edges``, ``build_corners_and_arcs``) and the
-errors. The model
-itself (``Scene``, ``Surface``, ``Plane``, ...) comes from :mod:`geobrep`, the kernels from
-:mod:`geobrep.geometry`. The built-in plugins below use only these three.
+Protocols their callables follow (``Reader``, ``Writer``, ``ClipFunction``, ``FitFunction``,
+...), the clipping context (``ClipContext``, ``SceneDraft``, ``halves``, ``pack_halves``), the
+fit result types (``FitResult``, ``FitReport``), ``atomic_write``, the topology helpers
+(``chain_arc_edges``, ``build_corners_and_arcs``) and the errors. The model itself (``Scene``,
+``Surface``, ``Plane``, ...) comes from :mod:`geobrep`, the kernels from :mod:`geobrep.geometry`.
+The built-in plugins below use only these three.
 
 The entry-point name (``example``) is the plugin's name in ``geobrep plugins`` and in
 ``GEOBREP_DISABLE_PLUGINS``. Built-in plugins are entry points of geobrep itself and load

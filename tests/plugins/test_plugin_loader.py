@@ -94,6 +94,7 @@ def test_good_plugins_load_and_bad_ones_fail_alone(fake_entry_points: SetEntryPo
         "fitters": (),
         "builders": (),
         "voxelizers": (),
+        "checks": (),
         "operations": (),
     }
     failed = {name for name, info in plugins.items() if info.status == "failed"}

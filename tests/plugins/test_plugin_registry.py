@@ -230,6 +230,7 @@ def test_registries_container() -> None:
         "fitters",
         "builders",
         "voxelizers",
+        "checks",
         "operations",
     }
     assert registries.by_kind()["formats"] is registries.formats
