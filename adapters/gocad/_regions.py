@@ -14,10 +14,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import BoolArray, IntArray
+
 __all__ = ["TetFaces", "root_vertices"]
 
-IntArray = NDArray[np.int64]
-BoolArray = NDArray[np.bool_]
 
 #: Local vertices of face k (the face opposite vertex k).
 _FACE_VERTICES = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]], dtype=np.int64)

@@ -14,11 +14,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.gocad._records import ErrorFactory
+from geobrep.geometry.arrays import FloatArray, IntArray
 
 __all__ = ["CellTable", "VertexTable"]
-
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 
 @dataclass

@@ -17,17 +17,15 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep.geometry import mesh
+from geobrep.geometry.arrays import FloatArray
 from geobrep.geometry.spatial_index import SpatialIndex
 
 if TYPE_CHECKING:
     from geobrep.model.entities import Surface
 
 __all__ = ["closest_points_on_triangles", "mesh_distances"]
-
-FloatArray = NDArray[np.float64]
 
 
 def _dot(a: FloatArray, b: FloatArray) -> FloatArray:

@@ -9,9 +9,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from geobrep.errors import DegenerateGeometryError, EntityValidationError
+from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.geometry.bbox import column_extremes
 from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
 
@@ -35,8 +36,6 @@ __all__ = [
     "unique_edges",
 ]
 
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 _INT64_MAX = np.iinfo(np.int64).max
 _MAX_KEY_BASE = 3_037_000_499  # floor(sqrt(2**63 - 1))

@@ -20,9 +20,10 @@ from dataclasses import dataclass, replace
 from math import comb
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from geobrep.errors import EntityValidationError
+from geobrep.geometry.arrays import FloatArray, IntArray
 
 __all__ = [
     "NurbsNet",
@@ -38,8 +39,6 @@ __all__ = [
     "tessellate",
 ]
 
-FloatArray = NDArray[np.float64]
-IntArray = NDArray[np.int64]
 
 #: Points evaluated per block, so that gathered control points stay within a few tens of MB.
 _BLOCK = 1 << 15

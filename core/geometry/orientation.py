@@ -18,14 +18,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from geobrep.geometry.arrays import BoolArray, IntArray
 from geobrep.geometry.mesh import _as_faces, _edge_table
 
 __all__ = ["OrientationFlips", "orientation_flips"]
-
-IntArray = NDArray[np.int64]
-BoolArray = NDArray[np.bool_]
 
 
 @dataclass(frozen=True)

@@ -10,13 +10,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from geobrep.errors import EntityValidationError
+from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.geometry.bbox import BoundingBox, boxes_plane_side, column_extremes
 from geobrep.geometry.plane import Plane
 
 __all__ = ["SpatialIndex"]
-
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 
 def _boxes(

@@ -46,6 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from geobrep.errors import DegenerateGeometryError, TopologyError
 from geobrep.geometry import mesh
+from geobrep.geometry.arrays import BoolArray, IntArray
 from geobrep.geometry.bbox import column_extremes
 from geobrep.model.entities import Surface
 from geobrep.model.scene import Scene
@@ -62,8 +63,6 @@ __all__ = [
 #: Default joining distance, relative to the diagonal of the patches' bounding box.
 DEFAULT_RELATIVE_TOLERANCE = 1e-8
 
-IntArray = NDArray[np.int64]
-BoolArray = NDArray[np.bool_]
 
 _HASH_A = np.uint64(0x9E3779B97F4A7C15)
 _HASH_B = np.uint64(0xC2B2AE3D27D4EB4F)

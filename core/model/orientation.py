@@ -28,7 +28,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep.errors import TopologyError
 from geobrep.geometry import mesh
@@ -38,7 +37,6 @@ from geobrep.model.scene import Scene
 
 __all__ = ["BlockOrientation", "block_orientations", "orient_blocks", "orient_patches"]
 
-IntArray = NDArray[np.int64]
 #: An open shell's volume decides its orientation when it exceeds this share of area^1.5.
 _OPEN_VOLUME_SHARE = 1e-6
 

@@ -21,9 +21,9 @@ from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep.geometry import Plane, boxes_plane_side, mesh
+from geobrep.geometry.arrays import IntArray
 from geobrep.model.arcs import build_corners_and_arcs
 from geobrep.model.entities import Block, Entity, PatchSide, Surface
 from geobrep.model.scene import Group, Scene
@@ -34,8 +34,6 @@ if TYPE_CHECKING:
     from geobrep.ops.clipping import ClipContext, Keep, SceneDraft
 
 __all__ = ["carry_topology"]
-
-IntArray = NDArray[np.int64]
 
 
 def carry_topology(

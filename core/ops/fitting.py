@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 from pydantic import BaseModel, ConfigDict, Field, JsonValue
 
 from geobrep.errors import EntityValidationError, OptionsError, PluginError
+from geobrep.geometry.arrays import FloatArray
 from geobrep.model.entities import Entity, NurbsSurface, PointSet, PolyLine, Surface
 
 if TYPE_CHECKING:
@@ -50,7 +51,6 @@ __all__ = [
     "fit",
 ]
 
-FloatArray = NDArray[np.float64]
 
 #: Relative agreement of a written mesh's σ and max |d| with the fitted surface's.
 WITHIN = 0.02

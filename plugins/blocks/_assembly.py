@@ -13,9 +13,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep import Arc, Block, Corner, Entity, Group, Patch, PatchSide, Scene, Surface, Topology
+from geobrep.geometry.arrays import IntArray
 from geobrep.plugins import UNIVERSE_KIND
 from geobrep.plugins.blocks._arcs import ArcChains
 from geobrep.plugins.blocks._measures import PatchMeasures
@@ -26,8 +26,6 @@ from geobrep.plugins.blocks._units import block_attributes
 from geobrep.plugins.blocks._universe import Bodies
 
 __all__ = ["Assembly", "assemble"]
-
-IntArray = NDArray[np.int64]
 
 
 @dataclass(frozen=True)

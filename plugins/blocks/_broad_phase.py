@@ -24,13 +24,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.plugins.blocks._csr import concatenated_ranges
 
 __all__ = ["overlapping_pairs"]
 
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
-BoolArray = NDArray[np.bool_]
 
 #: Triangles larger than this many median extents are kept only in the cells they come near.
 _LARGE_FACTOR = 2.0

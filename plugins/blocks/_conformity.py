@@ -23,9 +23,9 @@ from collections import defaultdict
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep.errors import TopologyError
+from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.plugins.blocks._broad_phase import overlapping_pairs
 from geobrep.plugins.blocks._csr import concatenated_ranges
 from geobrep.plugins.blocks._patches import PatchSplit
@@ -41,9 +41,6 @@ __all__ = [
     "triangles_intersect",
 ]
 
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
-BoolArray = NDArray[np.bool_]
 
 _MAX_LISTED = 8
 #: Contacts within this many tolerances of a line two surfaces share are no defect.

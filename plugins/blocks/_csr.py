@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
+
+from geobrep.geometry.arrays import FloatArray, IntArray
 
 __all__ = ["concatenated_ranges", "group_sums"]
-
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 
 def concatenated_ranges(starts: IntArray, counts: IntArray) -> IntArray:

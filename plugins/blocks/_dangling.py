@@ -12,16 +12,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import IntArray
 from geobrep.plugins.blocks._arcs import ArcChains
 from geobrep.plugins.blocks._csr import group_sums
 from geobrep.plugins.blocks._patches import PatchSplit
 from geobrep.plugins.blocks._soup import Soup
 
 __all__ = ["DanglingPatch", "describe_dangling", "free_border_arcs", "free_border_patches"]
-
-IntArray = NDArray[np.int64]
 
 
 @dataclass(frozen=True)

@@ -10,15 +10,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import FloatArray
 from geobrep.plugins.blocks._csr import group_sums
 from geobrep.plugins.blocks._patches import PatchSplit
 from geobrep.plugins.blocks._soup import Soup
 
 __all__ = ["PatchMeasures", "measure_patches"]
-
-FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -12,16 +12,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import BoolArray, IntArray
 from geobrep.plugins.blocks._arcs import ArcChains
 from geobrep.plugins.blocks._csr import concatenated_ranges
 from geobrep.plugins.blocks._patches import PatchSplit
 
 __all__ = ["DirectionTriangles", "direction_triangles"]
-
-IntArray = NDArray[np.int64]
-BoolArray = NDArray[np.bool_]
 
 
 @dataclass(frozen=True)

@@ -12,14 +12,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep.geometry import mesh
+from geobrep.geometry.arrays import IntArray
 from geobrep.plugins.blocks._soup import Soup
 
 __all__ = ["PatchSplit", "split_patches"]
-
-IntArray = NDArray[np.int64]
 
 
 @dataclass(frozen=True)

@@ -19,9 +19,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep.errors import TopologyError
+from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.plugins.blocks._arcs import ArcChains
 from geobrep.plugins.blocks._csr import concatenated_ranges
 from geobrep.plugins.blocks._orientation import DirectionTriangles, direction_triangles
@@ -29,9 +29,6 @@ from geobrep.plugins.blocks._patches import PatchSplit
 
 __all__ = ["SortedArcs", "radial_angles", "sort_arcs"]
 
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
-BoolArray = NDArray[np.bool_]
 
 #: Relative length under which a third vertex counts as lying on the arc's line.
 _COLLINEAR_RTOL = 1e-12

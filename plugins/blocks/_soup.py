@@ -12,19 +12,15 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep import Surface
 from geobrep.errors import DegenerateGeometryError
 from geobrep.geometry import mesh
+from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.geometry.bbox import column_extremes
 from geobrep.plugins.blocks.precision import Precision, data_tolerance, measure_precision
 
 __all__ = ["Soup", "build_soup"]
-
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
-BoolArray = NDArray[np.bool_]
 
 
 @dataclass(frozen=True)

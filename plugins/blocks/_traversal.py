@@ -15,13 +15,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import IntArray
 from geobrep.plugins.blocks._orientation import DirectionTriangles
 
 __all__ = ["Regions", "side_node", "traverse"]
-
-IntArray = NDArray[np.int64]
 
 
 def side_node(patch: IntArray, side: IntArray) -> IntArray:

@@ -12,16 +12,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.plugins.blocks._measures import PatchMeasures
 from geobrep.plugins.blocks._patches import PatchSplit
 from geobrep.plugins.blocks._soup import Soup
 
 __all__ = ["HORIZON_KINDS", "BlockAttributes", "block_attributes", "unit_name"]
 
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 #: Surface kinds read as stratigraphic horizons.
 HORIZON_KINDS = frozenset(

@@ -16,8 +16,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.geometry.bbox import column_extremes
 from geobrep.plugins.blocks._csr import group_sums
 from geobrep.plugins.blocks._measures import PatchMeasures
@@ -27,8 +27,6 @@ from geobrep.plugins.blocks._traversal import Regions
 
 __all__ = ["Bodies", "find_universe", "winding_number"]
 
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 #: Volume, relative to the model's bounding-box volume, under which a region encloses nothing.
 _EMPTY_VOLUME_RTOL = 1e-12

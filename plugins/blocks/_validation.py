@@ -22,10 +22,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep import Block, Scene, Surface
 from geobrep.errors import TopologyError
+from geobrep.geometry.arrays import BoolArray, IntArray
 from geobrep.plugins.blocks._csr import concatenated_ranges
 from geobrep.plugins.blocks._measures import PatchMeasures
 from geobrep.plugins.blocks._patches import PatchSplit
@@ -34,8 +34,6 @@ from geobrep.plugins.blocks.report import BlockCheck
 
 __all__ = ["Validation", "validate_scene"]
 
-IntArray = NDArray[np.int64]
-BoolArray = NDArray[np.bool_]
 
 _MAX_LISTED = 10
 

@@ -34,11 +34,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+
+from geobrep.geometry.arrays import FloatArray
 
 __all__ = ["CEILING", "FLOOR", "QUANTA", "Precision", "data_tolerance", "measure_precision"]
 
-FloatArray = NDArray[np.float64]
 
 #: Tolerance in quanta of the data's precision.
 QUANTA = 4.0

@@ -16,20 +16,17 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep import Block, Polygon, Scene, Surface
 from geobrep.errors import TopologyError
 from geobrep.geometry import Plane, boxes_plane_side, mesh
+from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip._caps import cap_rings, cap_triangles, open_boundary
 from geobrep.plugins.clip._surfaces import surface_cut
 from geobrep.plugins.clip.options import ClipOptions, tolerance_of
 
 __all__ = ["block_cut_edges", "clip_block", "section_block"]
-
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 
 def clip_block(

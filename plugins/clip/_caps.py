@@ -15,9 +15,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep.errors import DegenerateGeometryError, MissingDependencyError
+from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.plugins.clip._loops import edge_successors, order_cycles
 
 __all__ = [
@@ -29,8 +29,6 @@ __all__ = [
     "plane_basis",
 ]
 
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 #: Relative mismatch between the triangulated area and the loops' area that is an error.
 _AREA_RTOL = 1e-7

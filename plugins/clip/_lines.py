@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from geobrep import PointSet, PolyLine
 from geobrep.geometry import Plane
+from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip._sides import (
     crossing_points,
@@ -28,10 +29,6 @@ from geobrep.plugins.clip._sides import (
 from geobrep.plugins.clip.options import ClipOptions, tolerance_of
 
 __all__ = ["LineCut", "clip_polyline", "cut_segments", "section_polyline"]
-
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
-BoolArray = NDArray[np.bool_]
 
 
 @dataclass(frozen=True)

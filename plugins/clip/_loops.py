@@ -13,11 +13,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.errors import DegenerateGeometryError
+from geobrep.geometry.arrays import FloatArray, IntArray
 
 __all__ = ["edge_successors", "order_cycles", "order_paths"]
-
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 
 def edge_successors(edges: IntArray, uv: FloatArray, what: str) -> IntArray:

@@ -19,15 +19,13 @@ from numpy.typing import NDArray
 from geobrep import LinearOctree
 from geobrep.errors import DegenerateGeometryError
 from geobrep.geometry import Plane, boxes_plane_side
+from geobrep.geometry.arrays import FloatArray, IntArray, UIntArray
 from geobrep.geometry.morton import morton_decode
 from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip.options import OctreeClipOptions, tolerance_of
 
 __all__ = ["clip_octree", "leaf_boxes"]
 
-UIntArray = NDArray[np.uint64]
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 #: Most cells a subdivision may make along the plane at the finest level.
 MAX_SUBDIVIDED_CELLS = 20_000_000

@@ -16,11 +16,11 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep import Polygon, PolyLine
 from geobrep.errors import DegenerateGeometryError
 from geobrep.geometry import Plane
+from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip._caps import group_holes, loop_areas, plane_basis
 from geobrep.plugins.clip._lines import LineCut, cut_segments
@@ -28,9 +28,6 @@ from geobrep.plugins.clip._sides import interpolate_properties, vertex_sides
 from geobrep.plugins.clip.options import ClipOptions, tolerance_of
 
 __all__ = ["clip_polygon", "section_polygon"]
-
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 
 def _ring_of_vertex(polygon: Polygon) -> IntArray:

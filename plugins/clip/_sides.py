@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep import Property
+from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.plugins import PropertyMap
 
 __all__ = [
@@ -27,8 +28,6 @@ __all__ = [
     "vertex_sides",
 ]
 
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 #: Bit set in :func:`side_bits` for a point strictly on the negative side.
 NEGATIVE_BIT = 1

@@ -16,10 +16,10 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep import Polygon, PolyLine, Property, Surface
 from geobrep.geometry import Plane, mesh
+from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.plugins import ClipContext, Keep, PropertyMap, halves, pack_halves
 from geobrep.plugins.clip._caps import cap_rings, cap_triangles, open_boundary
 from geobrep.plugins.clip._loops import order_paths
@@ -29,9 +29,6 @@ from geobrep.plugins.clip._welding import UnweldedSurfaceWarning, closed_once_we
 from geobrep.plugins.clip.options import SurfaceClipOptions, tolerance_of
 
 __all__ = ["SurfaceCut", "clip_surface", "section_surface", "surface_cut"]
-
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
 
 
 @dataclass

@@ -16,6 +16,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.plugins.clip._sides import (
     NEGATIVE_BIT,
     POSITIVE_BIT,
@@ -26,9 +27,6 @@ from geobrep.plugins.clip._sides import (
 
 __all__ = ["HalfMesh", "InPlaneRule", "TriangleCut", "cut_triangles"]
 
-IntArray = NDArray[np.int64]
-FloatArray = NDArray[np.float64]
-BoolArray = NDArray[np.bool_]
 
 #: What happens to a triangle lying in the plane: kept on ``"both"`` sides (open surfaces), or
 #: given to the side its normal points away from (``"normal"``: closed surfaces, so each half

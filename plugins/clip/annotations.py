@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 
 from geobrep import Annotation, PolyLine
 from geobrep.geometry import Plane
+from geobrep.geometry.arrays import FloatArray
 from geobrep.plugins import ClipContext, Keep, halves, pack_halves
 from geobrep.plugins.clip._lines import cut_segments
 from geobrep.plugins.clip._sides import vertex_sides
@@ -29,9 +30,6 @@ from geobrep.plugins.clip.glyphs import ADVANCE, CAP_HEIGHT, DESCENDER, WIDTH, t
 from geobrep.plugins.clip.options import AnnotationClipOptions, tolerance_of
 
 __all__ = ["annotation_polyline", "annotation_strokes", "clip_annotation"]
-
-FloatArray = NDArray[np.float64]
-IntArray = NDArray[np.int64]
 
 
 def _frame(annotation: Annotation) -> tuple[FloatArray, FloatArray, FloatArray]:

@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 
 from geobrep import Entity, NurbsSurface, PointSet, PolyLine
 from geobrep.errors import DegenerateGeometryError, OptionsError
+from geobrep.geometry.arrays import FloatArray
 from geobrep.geometry.nurbs import (
     NurbsNet,
     basis_matrix,
@@ -60,7 +61,6 @@ __all__ = [
     "unmet_note",
 ]
 
-FloatArray = NDArray[np.float64]
 Level = TypeVar("Level")
 Fitted = TypeVar("Fitted")
 

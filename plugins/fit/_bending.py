@@ -18,11 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from numpy.typing import NDArray
+
+from geobrep.geometry.arrays import FloatArray
 
 __all__ = ["bending_matrix", "dual_widths", "laplacian_matrix", "second_difference"]
-
-FloatArray = NDArray[np.float64]
 
 
 def dual_widths(g: FloatArray) -> FloatArray:

@@ -13,10 +13,11 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from geobrep import NurbsSurface
 from geobrep.errors import DegenerateGeometryError, OptionsError
+from geobrep.geometry.arrays import FloatArray
 from geobrep.geometry.nurbs import basis_functions, basis_matrix, find_spans
 from geobrep.plugins.fit._knots import (
     averaged_knots,
@@ -27,7 +28,6 @@ from geobrep.plugins.fit._knots import (
 
 __all__ = ["BSplineCurve", "Side", "interpolate_curve", "surface_boundary"]
 
-FloatArray = NDArray[np.float64]
 Side = Literal["u0", "u1", "v0", "v1"]
 
 

@@ -20,11 +20,10 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import FloatArray
 from geobrep.geometry.nurbs import basis_derivatives, basis_functions, find_spans
 
 __all__ = ["curve_design_matrix", "normal_equations", "surface_design_matrix"]
-
-FloatArray = NDArray[np.float64]
 
 
 def _basis(

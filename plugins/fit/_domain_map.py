@@ -25,12 +25,11 @@ import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from geobrep.errors import DegenerateGeometryError
+from geobrep.geometry.arrays import FloatArray
 from geobrep.geometry.nurbs import NurbsNet, surface_derivatives
 from geobrep.plugins.fit._bending import laplacian_matrix
 
 __all__ = ["check_fold_free", "fill_net", "piecewise_linear", "planar_map"]
-
-FloatArray = NDArray[np.float64]
 
 
 def fill_net(

@@ -18,13 +18,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep.errors import DegenerateGeometryError
+from geobrep.geometry.arrays import FloatArray
 
 __all__ = ["LocalFrame"]
-
-FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

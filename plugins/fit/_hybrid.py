@@ -26,6 +26,7 @@ from scipy.spatial import cKDTree
 
 from geobrep import Entity, NurbsSurface, PointSet
 from geobrep.errors import DegenerateGeometryError, OptionsError
+from geobrep.geometry.arrays import FloatArray
 from geobrep.geometry.nurbs import NurbsNet, greville_abscissae, surface_points
 from geobrep.plugins import FitResult
 from geobrep.plugins.fit._approximation import (
@@ -52,7 +53,6 @@ from geobrep.plugins.fit.report import accuracy_report, sigma
 
 __all__ = ["Layout", "fit_hybrid", "layout_knots", "seam_gap"]
 
-FloatArray = NDArray[np.float64]
 LABEL = "fitter 'hybrid'"
 
 

@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.errors import DegenerateGeometryError
+from geobrep.geometry.arrays import FloatArray
 
 __all__ = [
     "approximation_knots",
@@ -23,8 +24,6 @@ __all__ = [
     "missing_knots",
     "uniform_knots",
 ]
-
-FloatArray = NDArray[np.float64]
 
 
 def chord_parameters(

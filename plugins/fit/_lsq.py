@@ -20,10 +20,9 @@ import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
 from geobrep.errors import DegenerateGeometryError
+from geobrep.geometry.arrays import FloatArray
 
 __all__ = ["single_threaded_blas", "solve_penalised"]
-
-FloatArray = NDArray[np.float64]
 
 
 @cache

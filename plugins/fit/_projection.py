@@ -17,15 +17,13 @@ over every knot span (a k-d tree query), or from the caller (a fitter knows its 
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from geobrep import NurbsSurface
+from geobrep.geometry.arrays import FloatArray
 from geobrep.geometry.nurbs import NurbsNet, surface_derivatives, surface_grid, surface_points
 
 __all__ = ["initial_parameters", "invert_planar_map", "project_points"]
-
-FloatArray = NDArray[np.float64]
 
 
 def _net(surface: NurbsSurface | NurbsNet) -> NurbsNet:

@@ -24,18 +24,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from geobrep.errors import DegenerateGeometryError, OptionsError
+from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.geometry.nurbs import NurbsNet, basis_matrix, surface_points
 from geobrep.plugins.fit._curves import BSplineCurve, interpolate_curve
 from geobrep.plugins.fit._knots import averaged_knots, chord_parameters, merge_knots
 
 __all__ = ["SkinnedNet", "lattice_angle", "rows_from_lattice", "skin_rows"]
-
-FloatArray = NDArray[np.float64]
-IntArray = NDArray[np.int64]
 
 
 @dataclass(frozen=True)

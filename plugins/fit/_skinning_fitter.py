@@ -7,6 +7,7 @@ from numpy.typing import NDArray
 
 from geobrep import Entity, NurbsSurface, PointSet, PolyLine
 from geobrep.errors import DegenerateGeometryError, OptionsError
+from geobrep.geometry.arrays import IntArray
 from geobrep.plugins import FitResult
 from geobrep.plugins.fit._domain_map import check_fold_free
 from geobrep.plugins.fit._frame import LocalFrame
@@ -18,7 +19,6 @@ from geobrep.plugins.fit.report import accuracy_report
 __all__ = ["fit_skinning", "sections_of"]
 
 LABEL = "fitter 'skinning'"
-IntArray = NDArray[np.int64]
 
 
 def sections_of(

@@ -15,17 +15,14 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from numpy.typing import NDArray
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from geobrep import PointSet
 from geobrep.errors import DegenerateGeometryError, OptionsError
+from geobrep.geometry.arrays import BoolArray, FloatArray
 
 __all__ = ["core_by_density", "core_by_property", "inside_polygon", "otsu_threshold"]
-
-FloatArray = NDArray[np.float64]
-BoolArray = NDArray[np.bool_]
 
 
 def inside_polygon(xy: FloatArray, polygon: FloatArray) -> BoolArray:

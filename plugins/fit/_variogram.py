@@ -27,6 +27,7 @@ from scipy import optimize, special
 from scipy.spatial.distance import pdist
 
 from geobrep.errors import DegenerateGeometryError, OptionsError
+from geobrep.geometry.arrays import FloatArray
 
 __all__ = [
     "MODELS",
@@ -36,7 +37,6 @@ __all__ = [
     "variogram_from_options",
 ]
 
-FloatArray = NDArray[np.float64]
 MODELS = ("spherical", "exponential", "gaussian", "matern")
 
 

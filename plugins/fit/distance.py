@@ -14,15 +14,13 @@ the candidate triangles, Ericson's region tests the closest point on each).
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 from geobrep import NurbsSurface, Surface
+from geobrep.geometry.arrays import FloatArray
 from geobrep.geometry.distance import closest_points_on_triangles, mesh_distances
 from geobrep.plugins.fit._projection import project_points
 
 __all__ = ["closest_points_on_triangles", "mesh_distances", "surface_distances"]
-
-FloatArray = NDArray[np.float64]
 
 
 def surface_distances(

@@ -38,6 +38,7 @@ from scipy.spatial.distance import cdist, pdist, squareform
 
 from geobrep import Entity, Surface
 from geobrep.errors import DegenerateGeometryError, OptionsError
+from geobrep.geometry.arrays import FloatArray
 from geobrep.plugins import FitResult
 from geobrep.plugins.fit._approximation import collect_points
 from geobrep.plugins.fit._lsq import single_threaded_blas
@@ -53,7 +54,6 @@ from geobrep.plugins.fit.report import accuracy_report
 
 __all__ = ["fit_kriging", "krige"]
 
-FloatArray = NDArray[np.float64]
 LABEL = "fitter 'kriging'"
 #: Distances at or below this count as zero (a target on a datum), as PyKrige's ``eps``.
 EPS = 1e-10

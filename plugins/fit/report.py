@@ -17,11 +17,10 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.geometry.arrays import FloatArray
 from geobrep.plugins import Deviation, FitReport, SubsetReport
 
 __all__ = ["accuracy_report", "sigma"]
-
-FloatArray = NDArray[np.float64]
 
 
 def sigma(distances: FloatArray) -> float:
