@@ -70,6 +70,26 @@ def test_convert_jobs_reports_only_the_killer(tmp_path: Path, inputs: Path) -> N
     assert f"{GOOD} converted, 1 failed" in result.stdout
 
 
+@pytest.mark.parametrize(
+    ("args", "converted"),
+    [((), 0), (("--jobs", "1"), 0), (("--jobs", "2"), None)],
+    ids=["default", "jobs 1", "jobs 2, one input"],
+)
+def test_in_process_the_killer_ends_the_run(
+    tmp_path: Path, inputs: Path, args: tuple[str, ...], converted: int | None
+) -> None:
+    """As docs/security.md says: without ``--jobs`` (or with one input) inputs are converted in
+    geobrep's process, so one whose reader kills it ends the run (no summary, the inputs after
+    it not converted); ``--jobs 2`` or more is the remedy."""
+    sources = ["in/*"] if converted is not None else ["in/a_worker_killer.kill"]
+    result = _geobrep(
+        "convert", *sources, "--to", "vtu", "-o", "out", "--no-progress", *args, cwd=tmp_path
+    )
+    assert result.returncode == 9, result.stderr  # the killer's own exit status
+    assert "converted," not in result.stdout  # no summary: the run ended there
+    assert not list((tmp_path / "out").glob("*.vtu"))  # the killer sorts first
+
+
 def test_pipeline_jobs_reports_only_the_killer(tmp_path: Path, inputs: Path) -> None:
     (tmp_path / "p.yaml").write_text(
         "inputs: ['in/*']\noutput: out\nsteps:\n  - write: {format: native}\n", encoding="utf-8"
