@@ -22,6 +22,7 @@ from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
 from geobrep.model.entities import Entity
 from geobrep.model.entities.base import VertexEntity
 from geobrep.model.scene import Group, Scene
+from geobrep.model.topology import Topology
 
 __all__ = [
     "SKIPPED_ON_READ",
@@ -134,10 +135,21 @@ def restrict_scene(scene: Scene, caps: FormatCapabilities) -> Scene:
     return Scene(
         entities=kept,
         groups=groups,
+        topology=_kept_topology(scene, caps, ids),
         crs=scene.crs if caps.crs else None,
         name=scene.name,
         metadata=scene.metadata,
     )
+
+
+def _kept_topology(scene: Scene, caps: FormatCapabilities, ids: set[int | None]) -> Topology:
+    """The scene's topology when the format holds it and every surface and block it names is
+    kept (a format of surfaces and blocks that drops tetrahedra keeps the blocks' sides)."""
+    if not caps.topology:
+        return Topology()
+    named: set[int | None] = {p.surface for p in scene.topology.patches}
+    named |= {b for p in scene.topology.patches for b in (p.positive_block, p.negative_block)}
+    return scene.topology if (named - {None}) <= ids else Topology()
 
 
 def _filter_group(group: Group, ids: set[int | None]) -> Group:

@@ -15,7 +15,19 @@ from geobrep.model.properties import Property
 from geobrep.model.scene import Scene
 
 #: Formats the meshio, ply and pyvista adapters (and the native format) register.
-OUR_FORMATS = ("native", "vtu", "vtk", "gmsh", "obj", "stl", "off", "ply", "vtp", "csv")
+OUR_FORMATS = (
+    "native",
+    "vtu",
+    "vtk",
+    "gmsh",
+    "obj",
+    "stl",
+    "off",
+    "ply",
+    "vtp",
+    "csv",
+    "resqml",
+)
 
 
 def rich_scene() -> Scene:

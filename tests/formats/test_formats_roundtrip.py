@@ -78,7 +78,7 @@ def test_capability_losses_empty_when_everything_fits(scene: Scene) -> None:
 
 
 @pytest.mark.parametrize("file_name", GOCAD_FILES)
-@pytest.mark.parametrize("name", ["vtu", "ply", "vtk", "vtp"])
+@pytest.mark.parametrize("name", ["vtu", "ply", "vtk", "vtp", "resqml"])
 def test_roundtrip_gocad_files(file_name: str, name: str, tmp_path: Path) -> None:
     if "gocad" not in registries().formats:
         pytest.skip("the GOCAD adapter is not installed")

@@ -1,0 +1,275 @@
+"""A RESQML 2.0.1 model (``.epc`` + ``.h5``) read through resqpy into a scene.
+
+Triangulated sets become surfaces (one patch label per RESQML patch, unless geobrep's patch
+property says more), point sets point sets, polyline sets and polylines polylines, geobody
+interpretations written by geobrep blocks. Coordinates are taken from each representation's
+local CRS to the world: offsets added, depth turned into z up. What the reader does not turn
+into entities (grids, wells, ...) is listed in ``scene.metadata["skipped_on_read"]``.
+"""
+
+from __future__ import annotations
+
+import warnings
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep.adapters.limits import check_declared
+from geobrep.adapters.resqml._records import (
+    decode_record,
+    properties_from,
+    scene_from_record,
+)
+from geobrep.adapters.resqml._writer import PATCH_PROPERTY
+from geobrep.errors import FormatError
+from geobrep.host.capabilities import SKIPPED_ON_READ
+from geobrep.model.crs import CRS
+from geobrep.model.entities import Block, Entity, PointSet, PolyLine, Surface
+from geobrep.model.scene import Scene
+
+__all__ = ["read_resqml"]
+
+#: Interpretation type -> geobrep kind.
+_KINDS = {
+    "HorizonInterpretation": "horizon",
+    "FaultInterpretation": "fault",
+    "BoundaryFeatureInterpretation": "boundary",
+    "GeobodyBoundaryInterpretation": "boundary",
+}
+_REPRESENTATIONS = (
+    "TriangulatedSetRepresentation",
+    "PointSetRepresentation",
+    "PolylineSetRepresentation",
+    "PolylineRepresentation",
+)
+_QUIET = ("obj_EpcExternalPartReference", "obj_PropertyKind", "Feature", "Interpretation", "Crs")
+
+
+def _check_sizes(path: Path) -> Path:
+    """Refuse an EPC or HDF5 file declaring more than its read budget; the .h5 beside it."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            declared = sum(info.file_size for info in archive.infolist())
+    except (zipfile.BadZipFile, OSError) as exc:
+        raise FormatError(f"not an EPC package: {exc}", path) from exc
+    check_declared(declared, path.stat().st_size, "the EPC package", path)
+    h5 = path.with_suffix(".h5")
+    if h5.exists():
+        total = 0
+        try:
+            with h5py.File(h5, "r") as store:
+
+                def add(name: str, item: Any) -> None:
+                    nonlocal total
+                    if isinstance(item, h5py.Dataset):
+                        total += int(item.size) * item.dtype.itemsize
+
+                store.visititems(add)
+        except OSError as exc:
+            raise FormatError(f"the HDF5 file beside it cannot be read: {exc}", h5) from exc
+        check_declared(total, h5.stat().st_size, "its datasets", h5)
+    return h5
+
+
+def read_resqml(path: Path) -> Scene:
+    """The scene of the RESQML model ``path``."""
+    import resqpy.model as rq
+
+    _check_sizes(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            model = rq.Model(str(path))
+            model.h5_set_default_override("dir")  # the .h5 beside the .epc, whatever it says
+            return _scene(model, path)
+        except FormatError:
+            raise
+        except (AssertionError, KeyError, ValueError, TypeError, IndexError, OSError) as exc:
+            raise FormatError(
+                f"RESQML model cannot be read: {type(exc).__name__}: {exc}", path
+            ) from exc
+
+
+def _scene(model: Any, path: Path) -> Scene:
+    import resqpy.crs as rqc
+
+    crs_uuid = model.uuid(obj_type="LocalDepth3dCrs") or model.uuid(obj_type="LocalTime3dCrs")
+    crs_obj = None if crs_uuid is None else rqc.Crs(model, uuid=crs_uuid)
+    record = None if crs_obj is None else decode_record(crs_obj.extra_metadata)
+    entities: list[Entity] = []
+    for obj_type in _REPRESENTATIONS:
+        for uuid in model.uuids(obj_type=obj_type):
+            entities.append(_entity(model, obj_type, uuid))
+    entities.extend(_blocks(model))
+    entities = _with_ids(entities)
+    scene = scene_from_record(entities, record, _crs(crs_obj), path.stem)
+    skipped = _skipped(model)
+    if skipped:
+        scene = scene.replace(metadata={**scene.metadata, SKIPPED_ON_READ: skipped})
+    return scene
+
+
+def _crs(crs: Any) -> CRS | None:
+    if crs is None:
+        return None
+    epsg = int(crs.epsg_code) if crs.epsg_code and str(crs.epsg_code).isdigit() else None
+    return CRS(
+        name=crs.title or None,
+        epsg=epsg,
+        axis_units=(crs.xy_units, crs.xy_units, crs.z_units),
+        z_positive="down" if crs.z_inc_down else "up",
+    )
+
+
+def _world(model: Any, crs_uuid: Any, points: NDArray[Any]) -> NDArray[np.float64]:
+    """Local CRS coordinates as world coordinates, z up."""
+    import resqpy.crs as rqc
+
+    crs = rqc.Crs(model, uuid=crs_uuid)
+    world = np.array(points, dtype=np.float64).reshape(-1, 3)
+    if crs.rotation:
+        world = crs.local_to_global_array(world.copy(), global_z_inc_down=crs.z_inc_down)
+    else:
+        offset = np.array([crs.x_offset, crs.y_offset, crs.z_offset], dtype=np.float64)
+        axes = np.flatnonzero(offset)  # adding a zero would turn -0.0 into 0.0
+        world[:, axes] += offset[axes]
+    if crs.z_inc_down:
+        world[:, 2] = -world[:, 2]
+    return world
+
+
+def _kind(model: Any, root: Any, record: dict[str, Any] | None) -> str | None:
+    if record is not None:
+        kind = record.get("kind")
+        return kind if isinstance(kind, str) else None
+    import resqpy.olio.xml_et as rqet
+
+    node = rqet.find_tag(root, "RepresentedInterpretation")
+    if node is None:
+        return None
+    interpretation = model.referenced_node(node)
+    return (
+        None
+        if interpretation is None
+        else _KINDS.get(rqet.node_type(interpretation, strip_obj=True))
+    )
+
+
+def _entity(model: Any, obj_type: str, uuid: Any) -> Entity:
+    import resqpy.lines as rql
+    import resqpy.surface as rqs
+
+    if obj_type == "TriangulatedSetRepresentation":
+        rep = rqs.Surface(model, uuid=uuid)
+        return _surface(model, rep)
+    if obj_type == "PointSetRepresentation":
+        rep = rqs.PointSet(model, uuid=uuid)
+        vertices = _world(model, rep.crs_uuid, rep.full_array_ref())
+        return _finish(model, rep, PointSet(vertices=vertices), len(vertices), 0)
+    if obj_type == "PolylineSetRepresentation":
+        rep = rql.PolylineSet(model, uuid=uuid)
+        counts = np.asarray(rep.count_perpol, dtype=np.int64)
+        closed = np.asarray(rep.closed_array, dtype=bool)
+        coordinates = rep.coordinates
+    else:
+        rep = rql.Polyline(model, uuid=uuid)
+        counts, closed = np.array([len(rep.coordinates)]), np.array([bool(rep.isclosed)])
+        coordinates = rep.coordinates
+    vertices = _world(model, rep.crs_uuid, coordinates)
+    line = PolyLine(
+        vertices=vertices,
+        indices=np.arange(len(vertices)),
+        part_offsets=np.concatenate([[0], np.cumsum(counts)]),
+        closed=closed,
+    )
+    return _finish(model, rep, line, len(vertices), line.n_cells)
+
+
+def _surface(model: Any, rep: Any) -> Entity:
+    triangles, points = rep.triangles_and_points()
+    vertices = _world(model, rep.crs_uuid, points)
+    labels = None
+    if rep.number_of_patches() > 1:
+        labels = np.asarray(rep.patch_indices_for_triangle_indices(np.arange(len(triangles))))
+    surface = Surface(
+        vertices=vertices, faces=np.asarray(triangles, dtype=np.int64), patch_labels=labels
+    )
+    return _finish(model, rep, surface, len(vertices), len(triangles))
+
+
+def _properties(rep: Any, n_nodes: int, n_cells: int) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(point properties, cell properties) of ``rep``: name -> (values, unit)."""
+    import resqpy.property as rqp
+
+    collection = rqp.PropertyCollection(support=rep)
+    nodes: dict[str, Any] = {}
+    cells: dict[str, Any] = {}
+    for part in collection.parts():
+        name = collection.citation_title_for_part(part)
+        element = collection.indexable_for_part(part)
+        values = np.array(collection.cached_part_array_ref(part, masked=False))
+        unit = None if not collection.continuous_for_part(part) else collection.uom_for_part(part)
+        unit = None if unit in (None, "Euc") else unit
+        if element == "nodes" and len(values) == n_nodes:
+            nodes[name] = (values, unit)
+        elif element in ("faces", "intervals") and len(values) == n_cells:
+            cells[name] = (values, unit)
+    return nodes, cells
+
+
+def _finish(model: Any, rep: Any, entity: Entity, n_nodes: int, n_cells: int) -> Entity:
+    """``entity`` with the name, kind, properties and record of ``rep``."""
+    record = decode_record(rep.extra_metadata)
+    nodes, cells = _properties(rep, n_nodes, n_cells)
+    changes: dict[str, Any] = {"name": rep.title or "", "kind": _kind(model, rep.root, record)}
+    patch = cells.pop(PATCH_PROPERTY, None)
+    if patch is not None and isinstance(entity, Surface):
+        changes["patch_labels"] = np.asarray(patch[0], dtype=np.int64)
+    if record is not None:
+        changes["id"] = record.get("id")
+        changes["metadata"] = record.get("metadata", {})
+        if isinstance(entity, Surface) and record.get("patch_names"):
+            changes["patch_names"] = tuple(record["patch_names"])
+    changes["point_data"] = properties_from(nodes, (record or {}).get("point_data"))
+    changes["cell_data"] = properties_from(cells, (record or {}).get("cell_data"))
+    return entity.replace(**changes)
+
+
+def _blocks(model: Any) -> list[Entity]:
+    """The blocks geobrep wrote as geobody interpretations (others carry no sides)."""
+    import resqpy.organize as rqo
+
+    blocks: list[Entity] = []
+    for uuid in model.uuids(obj_type="GeobodyInterpretation"):
+        interpretation = rqo.GeobodyInterpretation(model, uuid=uuid)
+        record = decode_record(interpretation.extra_metadata)
+        if record is not None and isinstance(record.get("block"), dict):
+            blocks.append(Block.model_validate(record["block"]))
+        else:
+            blocks.append(Block(name=interpretation.title or "", kind="unit"))
+    return blocks
+
+
+def _with_ids(entities: list[Entity]) -> list[Entity]:
+    """Entities with their recorded ids, or fresh ones when ids are missing or repeated."""
+    ids = [e.id for e in entities]
+    if None not in ids and len(set(ids)) == len(ids):
+        return entities
+    return [e.replace(id=i) for i, e in enumerate(entities)]
+
+
+def _skipped(model: Any) -> list[str]:
+    """The parts that are neither entities nor what entities are built from."""
+    skipped = []
+    for part in model.parts():
+        kind = part.split("_")[1] if part.count("_") >= 2 else part
+        if kind in _REPRESENTATIONS or kind in ("GeobodyInterpretation",) or "Property" in kind:
+            continue
+        if any(q in kind or q == f"obj_{kind}" for q in _QUIET):
+            continue
+        skipped.append(f"RESQML {kind} '{model.citation_title_for_part(part)}'")
+    return skipped
