@@ -25,7 +25,7 @@ from geobrep.adapters.resqml._records import (
     scene_from_record,
 )
 from geobrep.adapters.resqml._writer import PATCH_PROPERTY
-from geobrep.errors import FormatError
+from geobrep.errors import FormatError, GeobrepError
 from geobrep.host.capabilities import SKIPPED_ON_READ
 from geobrep.model.crs import CRS
 from geobrep.model.entities import Block, Entity, PointSet, PolyLine, Surface
@@ -58,20 +58,21 @@ def _check_sizes(path: Path) -> Path:
         raise FormatError(f"not an EPC package: {exc}", path) from exc
     check_declared(declared, path.stat().st_size, "the EPC package", path)
     h5 = path.with_suffix(".h5")
-    if h5.exists():
-        total = 0
-        try:
-            with h5py.File(h5, "r") as store:
+    if not h5.exists():
+        raise FormatError(f"the HDF5 file beside it ({h5.name}) is missing", path)
+    total = 0
+    try:
+        with h5py.File(h5, "r") as store:
 
-                def add(name: str, item: Any) -> None:
-                    nonlocal total
-                    if isinstance(item, h5py.Dataset):
-                        total += int(item.size) * item.dtype.itemsize
+            def add(name: str, item: Any) -> None:
+                nonlocal total
+                if isinstance(item, h5py.Dataset):
+                    total += int(item.size) * item.dtype.itemsize
 
-                store.visititems(add)
-        except OSError as exc:
-            raise FormatError(f"the HDF5 file beside it cannot be read: {exc}", h5) from exc
-        check_declared(total, h5.stat().st_size, "its datasets", h5)
+            store.visititems(add)
+    except OSError as exc:
+        raise FormatError(f"the HDF5 file beside it cannot be read: {exc}", h5) from exc
+    check_declared(total, h5.stat().st_size, "its datasets", h5)
     return h5
 
 
@@ -84,14 +85,12 @@ def read_resqml(path: Path) -> Scene:
         warnings.simplefilter("ignore")
         try:
             model = rq.Model(str(path))
-            model.h5_set_default_override("dir")  # the .h5 beside the .epc, whatever it says
+            model.h5_set_default_override("full")  # the .h5 of the same stem, as checked
             return _scene(model, path)
-        except FormatError:
+        except GeobrepError:
             raise
-        except (AssertionError, KeyError, ValueError, TypeError, IndexError, OSError) as exc:
-            raise FormatError(
-                f"RESQML model cannot be read: {type(exc).__name__}: {exc}", path
-            ) from exc
+        except Exception as exc:  # resqpy asserts, indexes and parses without checking first
+            raise FormatError(f"damaged RESQML model ({type(exc).__name__}: {exc})", path) from exc
 
 
 def _scene(model: Any, path: Path) -> Scene:
