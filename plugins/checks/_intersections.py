@@ -24,6 +24,7 @@ from geobrep.plugins.checks._common import (
     triangles,
     welded,
 )
+from geobrep.plugins.checks._pairs import near_pairs
 
 __all__ = ["contacts", "polyline_intersections", "self_intersections", "surface_intersections"]
 
@@ -44,14 +45,18 @@ def self_intersections(scene: Scene, options: Any, context: CheckContext) -> lis
         merged = maps[position[id(surface)]][tris]
         centre = surface.vertices.mean(axis=0)
         corners = surface.vertices[tris] - centre
-        i, j = overlapping_pairs(corners, np.arange(tris.shape[0]), margin=options.margin)
+        i, j = near_pairs(corners, options.margin)
+        columns = [np.ascontiguousarray(merged[:, a]) for a in range(3)]
         apart = np.ones(i.shape[0], dtype=np.bool_)
         for a in range(3):
+            mine = columns[a][i]
             for b in range(3):
-                apart &= merged[i, a] != merged[j, b]
+                apart &= mine != columns[b][j]
         i, j = i[apart], j[apart]
         hit = triangles_intersect(corners[i], corners[j], options.margin)
         i, j = i[hit], j[hit]
+        swap = source[i] > source[j]
+        i, j = np.where(swap, j, i), np.where(swap, i, j)
         order = np.lexsort((source[j], source[i]))
         i, j = i[order], j[order]
         middle = 0.5 * (corners[i].mean(axis=1) + corners[j].mean(axis=1)) + centre
