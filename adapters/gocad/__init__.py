@@ -1,4 +1,5 @@
-"""GOCAD ASCII formats: TSurf (.ts), PLine (.pl), VSet (.vs), TSolid (.so), Model3d (.ml), groups.
+"""GOCAD formats: TSurf (.ts), PLine (.pl), VSet (.vs), TSolid (.so), Model3d (.ml), groups,
+Voxet (.vo, with its property files) and Well (.wl).
 
 One format, ``gocad``, covers the family: the reader recognises each object by its
 ``GOCAD <Type>`` line (so a .ts holding a PLine still reads), the writer picks the object type
@@ -17,7 +18,7 @@ from geobrep.model.scene import Scene
 __all__ = ["EXTENSIONS", "geobrep_register_formats", "looks_like_gocad"]
 
 #: File extensions of the GOCAD ASCII family.
-EXTENSIONS = (".ts", ".pl", ".vs", ".so", ".ml", ".gp")
+EXTENSIONS = (".ts", ".pl", ".vs", ".so", ".ml", ".gp", ".vo", ".wl")
 
 
 def looks_like_gocad(head: bytes) -> bool:
@@ -27,18 +28,27 @@ def looks_like_gocad(head: bytes) -> bool:
 
 
 def _read(path: Path, options: object) -> Scene:
+    from geobrep.adapters.gocad._grids import object_type_of, read_grid_object
     from geobrep.adapters.gocad._reader import read_gocad
     from geobrep.adapters.gocad.options import GocadOptions
 
     assert isinstance(options, GocadOptions)
+    grid_type = object_type_of(path)
+    if grid_type is not None:
+        return read_grid_object(path, grid_type)
     return read_gocad(path, options)
 
 
 def _write(scene: Scene, path: Path, options: object) -> None:
+    from geobrep.adapters.gocad._grids import grid_object_for, write_grid_object
     from geobrep.adapters.gocad._writer import write_gocad
     from geobrep.adapters.gocad.options import GocadOptions
 
     assert isinstance(options, GocadOptions)
+    grid_type = grid_object_for(path, options.object_type)
+    if grid_type is not None:
+        write_grid_object(scene, path, grid_type)
+        return
     write_gocad(scene, path, options)
 
 
@@ -50,10 +60,34 @@ _HELD = {
     ".so": ("TSolid", frozenset({"TetMesh"})),
     ".ml": ("Model3d", frozenset({"Surface", "Block"})),
     ".gp": ("group", frozenset({"Surface", "PolyLine", "PointSet", "TetMesh"})),
+    ".vo": ("Voxet", frozenset({"RegularGrid"})),
+    ".wl": ("Well", frozenset({"Well"})),
 }
 
 
-_FAMILY = frozenset({"Surface", "PolyLine", "PointSet", "TetMesh", "Block"})
+_FAMILY = frozenset({"Surface", "PolyLine", "PointSet", "TetMesh", "Block", "RegularGrid", "Well"})
+
+
+def _grid_losses(scene: Scene, path: Path) -> list[str]:
+    """What a Voxet or Well file cannot hold of the one entity it keeps."""
+    from geobrep.model.entities import RegularGrid, Well
+
+    suffix = path.suffix.lower()
+    lost: list[str] = []
+    for entity in scene.entities:
+        if suffix == ".vo" and isinstance(entity, RegularGrid):
+            if entity.point_data and entity.cell_data:
+                lost.append(f"{entity.label}: cell data (a Voxet holds node values)")
+            elif entity.cell_data:
+                lost.append(f"{entity.label}: cells (cell data are written at the cell centres)")
+            break
+        if suffix == ".wl" and isinstance(entity, Well):
+            if any(m.surface for m in entity.markers):
+                lost.append(f"{entity.label}: the surfaces its markers hit")
+            if entity.point_data or entity.cell_data:
+                lost.append(f"{entity.label}: station and segment properties")
+            break
+    return lost
 
 
 def _losses(scene: Scene, path: Path) -> list[str]:
@@ -63,6 +97,7 @@ def _losses(scene: Scene, path: Path) -> list[str]:
     object_type, held = _HELD.get(path.suffix.lower(), ("", frozenset()))
     if not held:
         return []
+    grid_lost = _grid_losses(scene, path) if object_type in ("Voxet", "Well") else []
     dropped: dict[str, int] = {}
     for entity in scene.entities:
         if entity.type in held or entity.type not in _FAMILY:
@@ -73,7 +108,7 @@ def _losses(scene: Scene, path: Path) -> list[str]:
             continue
         dropped[entity.type] = dropped.get(entity.type, 0) + 1
     kinds = ", ".join(sorted(held))
-    return [
+    return grid_lost + [
         f"{count} {type_name} entities dropped (a GOCAD {object_type} file holds {kinds})"
         for type_name, count in sorted(dropped.items())
     ]
@@ -81,20 +116,20 @@ def _losses(scene: Scene, path: Path) -> list[str]:
 
 @hookimpl
 def geobrep_register_formats(registry: FormatRegistry) -> None:
-    """Register the ``gocad`` format (.ts .pl .vs .so .ml .gp)."""
+    """Register the ``gocad`` format (.ts .pl .vs .so .ml .gp .vo .wl)."""
     from geobrep.adapters.gocad.options import GocadOptions
 
     registry.add(
         FormatSpec(
             name="gocad",
-            description="GOCAD ASCII: TSurf, PLine, VSet, TSolid, Model3d and groups",
+            description="GOCAD: TSurf, PLine, VSet, TSolid, Model3d, groups, Voxet and Well",
             extensions=EXTENSIONS,
             reader=_read,
             writer=_write,
             sniff=looks_like_gocad,
             options=GocadOptions,
             capabilities=FormatCapabilities(
-                entity_types=frozenset({"Surface", "PolyLine", "PointSet", "TetMesh", "Block"}),
+                entity_types=_FAMILY,
                 point_data=True,
                 cell_data=True,
                 names=True,

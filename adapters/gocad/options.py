@@ -28,8 +28,9 @@ class GocadOptions(BaseModel):
     """Reading: distance under which vertices of different surfaces are one point when a
     Model3d's corners and arcs are rebuilt (default: 1e-8 of the bounding-box diagonal)."""
     object_type: str | None = None
-    """Writing: ``TSurf``, ``PLine``, ``VSet``, ``TSolid``, ``Model3d`` or
-    ``HeterogeneousGroup``; default: from the extension (.ts .pl .vs .so .ml .gp)."""
+    """Writing: ``TSurf``, ``PLine``, ``VSet``, ``TSolid``, ``Model3d``,
+    ``HeterogeneousGroup``, ``Voxet`` or ``Well``; default: from the extension
+    (.ts .pl .vs .so .ml .gp .vo .wl)."""
 
     def merge_tolerance_for(self, diagonal: float) -> float:
         """The joining distance for a model whose bounding-box diagonal is ``diagonal``."""

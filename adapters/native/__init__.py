@@ -55,6 +55,9 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
                         "Annotation",
                         "Block",
                         "LinearOctree",
+                        "RegularGrid",
+                        "StructuredGrid",
+                        "Well",
                     }
                 ),
                 point_data=True,

@@ -38,7 +38,10 @@ from geobrep.model.entities import (
     Entity,
     LinearOctree,
     NurbsSurface,
+    RegularGrid,
+    StructuredGrid,
     VertexEntity,
+    Well,
 )
 from geobrep.model.scene import Scene
 
@@ -348,6 +351,9 @@ def _handedness(transform: _PointTransform, scene: Scene) -> float:
 
 def _transform_entity(entity: Entity, transform: _PointTransform) -> Entity:
     label = entity.label
+    if isinstance(entity, Well):
+        moved = transform(np.vstack([entity.head, entity.vertices]), label)
+        return entity.replace(head=moved[0], vertices=moved[1:])
     if isinstance(entity, VertexEntity):
         vertices = entity.vertices  # type: ignore[attr-defined]
         return entity.replace(vertices=transform(vertices, label))
@@ -368,10 +374,12 @@ def _transform_entity(entity: Entity, transform: _PointTransform) -> Entity:
             up=new_up / np.linalg.norm(new_up),
             height=float(np.linalg.norm(new_up)),
         )
-    if isinstance(entity, LinearOctree):
+    if isinstance(entity, StructuredGrid) and entity.points is not None:
+        return entity.replace(points=transform(entity.points, label))
+    if isinstance(entity, LinearOctree | RegularGrid | StructuredGrid):
         raise CRSError(
-            f"{label}: a linear octree is a grid of the source CRS and cannot be reprojected; "
-            "reproject the surfaces and voxelize again"
+            f"{label}: a {type(entity).__name__} is a grid of the source CRS and cannot be "
+            "reprojected; reproject its source data and grid it again"
         )
     return entity  # Blocks and other entities without coordinates
 

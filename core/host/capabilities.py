@@ -171,6 +171,9 @@ _ENTITY_ABBREVIATIONS = {
     "Annotation": "annotations",
     "Block": "blocks",
     "LinearOctree": "octrees",
+    "RegularGrid": "grids",
+    "StructuredGrid": "sgrids",
+    "Well": "wells",
 }
 
 

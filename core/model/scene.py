@@ -32,8 +32,11 @@ from geobrep.model.entities import (
     PointSet,
     Polygon,
     PolyLine,
+    RegularGrid,
+    StructuredGrid,
     Surface,
     TetMesh,
+    Well,
 )
 from geobrep.model.topology import Patch, Topology
 
@@ -259,6 +262,18 @@ class Scene(FrozenModel):
     @property
     def octrees(self) -> tuple[LinearOctree, ...]:
         return self.of_type(LinearOctree)
+
+    @property
+    def regular_grids(self) -> tuple[RegularGrid, ...]:
+        return self.of_type(RegularGrid)
+
+    @property
+    def structured_grids(self) -> tuple[StructuredGrid, ...]:
+        return self.of_type(StructuredGrid)
+
+    @property
+    def wells(self) -> tuple[Well, ...]:
+        return self.of_type(Well)
 
     @property
     def blocks(self) -> tuple[Block, ...]:

@@ -96,7 +96,7 @@ def read_warnings(path: Path) -> tuple[geobrep.Scene, list[str]]:
 # -- item 5: the tokenizer ------------------------------------------------------------------------
 def _every_test_line() -> Iterator[tuple[Path, int, str]]:
     for path in sorted(TESTS_DATA.rglob("*")):
-        if not path.is_file() or path.suffix in (".md", ".py", ".txt", ".sh"):
+        if not path.is_file() or path.suffix in (".md", ".py", ".txt", ".sh", ".tif", ".tiff"):
             continue
         source = Source.read(path)
         for index in range(source.n_lines):

@@ -9,13 +9,16 @@ from pydantic import Field
 from geobrep.model.entities.annotation import Annotation
 from geobrep.model.entities.base import Entity, VertexEntity
 from geobrep.model.entities.block import UNIVERSE_KIND, Block, PatchSide
+from geobrep.model.entities.grid import RegularGrid
 from geobrep.model.entities.nurbs import NurbsSurface
 from geobrep.model.entities.octree import LinearOctree
 from geobrep.model.entities.pointset import PointSet
 from geobrep.model.entities.polygon import Polygon
 from geobrep.model.entities.polyline import PolyLine
+from geobrep.model.entities.structured import StructuredGrid
 from geobrep.model.entities.surface import Surface
 from geobrep.model.entities.tetmesh import TetMesh
+from geobrep.model.entities.well import Well, WellLog, WellMarker, WellZone
 
 __all__ = [
     "ENTITY_TYPES",
@@ -30,9 +33,15 @@ __all__ = [
     "PointSet",
     "PolyLine",
     "Polygon",
+    "RegularGrid",
+    "StructuredGrid",
     "Surface",
     "TetMesh",
     "VertexEntity",
+    "Well",
+    "WellLog",
+    "WellMarker",
+    "WellZone",
 ]
 
 #: Every concrete entity class, by its ``type`` name.
@@ -48,6 +57,9 @@ ENTITY_TYPES: dict[str, type[Entity]] = {
         Annotation,
         Block,
         LinearOctree,
+        RegularGrid,
+        StructuredGrid,
+        Well,
     )
 }
 
@@ -60,6 +72,9 @@ AnyEntity: TypeAlias = Annotated[
     | NurbsSurface
     | Annotation
     | Block
-    | LinearOctree,
+    | LinearOctree
+    | RegularGrid
+    | StructuredGrid
+    | Well,
     Field(discriminator="type"),
 ]
