@@ -17,9 +17,11 @@ from typing import Any
 from geobrep.batch.pipeline import (
     BuildBlocksStep,
     BuildStep,
+    CheckStep,
     ClipBoxStep,
     ClipStep,
     FitStep,
+    RepairStep,
     ReprojectStep,
     SectionStep,
     VoxelizeStep,
@@ -103,6 +105,30 @@ def _voxelize(scene: Scene, step: VoxelizeStep) -> Scene:
     return scene.with_entities(voxelize(scene, **step.builder_options()))
 
 
+def check_scene(scene: Scene, step: CheckStep) -> Scene:
+    """``scene`` itself, after inspecting it: defects raise (``fail``), warn, or pass."""
+    import warnings
+
+    from geobrep.errors import TopologyError
+    from geobrep.ops.inspection import inspect
+
+    report = inspect(scene, step.checks, step.tolerance)
+    if report.ok or step.on_defects == "continue":
+        return scene
+    found = ", ".join(f"{name} {n}" for name, n in report.counts().items() if n)
+    message = f"check found {report.n_defects} defect(s): {found}"
+    if step.on_defects == "fail":
+        raise TopologyError(message)
+    warnings.warn(message, stacklevel=2)
+    return scene
+
+
+def _repair(scene: Scene, step: RepairStep) -> Scene:
+    from geobrep.ops.repairing import repair
+
+    return repair(scene, step.actions, step.tolerance)[0]
+
+
 def builtin_operations() -> list[OperationSpec]:
     """geobrep's own operations, in the order the documentation presents them."""
     return [
@@ -164,6 +190,20 @@ def builtin_operations() -> list[OperationSpec]:
             options=VoxelizeStep,
             function=_voxelize,
             writes="the scene with its linear octree appended",
+        ),
+        OperationSpec(
+            name="check",
+            summary="inspect models: defects with their locations (exit 3 when found)",
+            options=CheckStep,
+            function=check_scene,
+            writes="the scene unchanged (the defects in the summary)",
+        ),
+        OperationSpec(
+            name="repair",
+            summary="mend a model: weld, drop degenerate elements, split T-junctions, orient",
+            options=RepairStep,
+            function=_repair,
+            writes="the repaired scene (properties, ids and names kept)",
         ),
     ]
 

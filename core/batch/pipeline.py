@@ -72,6 +72,7 @@ __all__ = [
     "STEP_KINDS",
     "BuildBlocksStep",
     "BuildStep",
+    "CheckStep",
     "ClipBoxStep",
     "ClipStep",
     "ConvertStep",
@@ -79,6 +80,7 @@ __all__ = [
     "OperationStep",
     "Pipeline",
     "ReadStep",
+    "RepairStep",
     "ReprojectStep",
     "SectionStep",
     "StepOptions",
@@ -320,6 +322,38 @@ class VoxelizeStep(StepOptions):
         )
 
 
+class CheckStep(StepOptions):
+    """Inspect the scene (:func:`geobrep.inspect`); the scene flows on unchanged. Defects
+    ``fail`` the input (default), ``warn`` (a warning naming the counts), or ``continue``
+    (noted in the summary only)."""
+
+    kind: ClassVar[str] = "check"
+
+    checks: Annotated[tuple[str, ...] | None, Cli(parse=comma_items)] = None
+    """comma-separated check names, or all (default: the default checks)"""
+    tolerance: float | None = Field(default=None, ge=0, allow_inf_nan=False)
+    """distance under which points count as one (default: from the data's precision)"""
+    on_defects: Literal["fail", "warn", "continue"] = "fail"
+    """what defects do: fail, warn or continue (default: fail)"""
+
+    def check(self, registries: Registries) -> None:
+        for name in self.checks or ():
+            if name != "all":
+                _get(registries.checks, name, "check")
+
+
+class RepairStep(StepOptions):
+    """Mend what inspection finds (:func:`geobrep.repair`): weld, drop degenerate, duplicated
+    and isolated elements, split T-junctions, orient patches and blocks."""
+
+    kind: ClassVar[str] = "repair"
+
+    actions: Annotated[tuple[str, ...] | None, Cli(parse=comma_items)] = None
+    """comma-separated repair actions (default: all of them)"""
+    tolerance: float | None = Field(default=None, ge=0, allow_inf_nan=False)
+    """weld/contact tolerance (default: from the data's precision)"""
+
+
 class WriteStep(StepOptions):
     """Write the scene as it is at this step (the scene flows on unchanged) to
     ``<output>/<name>``: ``format`` names a registered format, ``name`` a file-name pattern with
@@ -429,6 +463,8 @@ _STEP_TYPES: tuple[type[StepOptions], ...] = (
     BuildBlocksStep,
     BuildStep,
     VoxelizeStep,
+    CheckStep,
+    RepairStep,
     WriteStep,
     ConvertStep,
 )
@@ -484,6 +520,14 @@ class VoxelizeEntry(_Entry):
     voxelize: VoxelizeStep
 
 
+class CheckEntry(_Entry):
+    check: CheckStep
+
+
+class RepairEntry(_Entry):
+    repair: RepairStep
+
+
 class WriteEntry(_Entry):
     write: WriteStep
 
@@ -517,6 +561,8 @@ Step = Annotated[
         Annotated[BuildBlocksEntry, Tag("build_blocks")],
         Annotated[BuildEntry, Tag("build")],
         Annotated[VoxelizeEntry, Tag("voxelize")],
+        Annotated[CheckEntry, Tag("check")],
+        Annotated[RepairEntry, Tag("repair")],
         Annotated[WriteEntry, Tag("write")],
         Annotated[ConvertEntry, Tag("convert")],
         SkipJsonSchema[Annotated[OperationEntry, Tag("operation")]],

@@ -20,6 +20,7 @@ so a failed input leaves no outputs behind.
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from os import PathLike
@@ -34,6 +35,7 @@ from geobrep.batch.outputs import OutputFolder, contained, format_name, name_fie
 from geobrep.batch.pipeline import (
     BuildBlocksStep,
     BuildStep,
+    CheckStep,
     ClipBoxStep,
     ClipStep,
     ConvertStep,
@@ -41,6 +43,7 @@ from geobrep.batch.pipeline import (
     OperationStep,
     Pipeline,
     ReadStep,
+    RepairStep,
     ReprojectStep,
     SectionStep,
     StepOptions,
@@ -52,6 +55,7 @@ from geobrep.errors import (
     FileAccessError,
     GeobrepError,
     OptionsError,
+    TopologyError,
 )
 from geobrep.host.capabilities import format_losses
 from geobrep.model.entities import Entity, LinearOctree, NurbsSurface, PointSet, PolyLine, Surface
@@ -480,6 +484,29 @@ def _voxelize(step: VoxelizeStep, scene: Scene, work: _Work) -> Applied:
     return result, [f"octree: {octree.n_leaves} leaves, depth {octree.depth}"]
 
 
+def _check(step: CheckStep, scene: Scene, work: _Work) -> Applied:
+    from geobrep.ops.inspection import inspect
+
+    report = inspect(scene, step.checks, step.tolerance)
+    found = {name: n for name, n in report.counts().items() if n}
+    text = ", ".join(f"{name} {n}" for name, n in found.items())
+    if not found:
+        return scene, [f"check: clean ({len(report.sections)} checks)"]
+    if step.on_defects == "fail":
+        raise TopologyError(f"check found {report.n_defects} defect(s): {text}")
+    if step.on_defects == "warn":
+        warnings.warn(f"check found {report.n_defects} defect(s): {text}", stacklevel=2)
+    return scene, [f"check: {report.n_defects} defect(s): {text}"]
+
+
+def _repair(step: RepairStep, scene: Scene, work: _Work) -> Applied:
+    from geobrep.ops.repairing import repair
+
+    repaired, report = repair(scene, step.actions, step.tolerance)
+    done = ", ".join(f"{a.action} {a.count}" for a in report.actions if a.count)
+    return repaired, [f"repair: {done or 'nothing to mend'}"]
+
+
 def _operation(step: OperationStep, scene: Scene, work: _Work) -> Applied:
     spec = work.registries.operations.for_step(step.operation)
     if spec is None:  # checked before the run: the plugin went away meanwhile
@@ -583,6 +610,8 @@ _APPLY: dict[type[StepOptions], Callable[[Any, Scene, _Work], Applied]] = {
     BuildBlocksStep: _build_blocks,
     BuildStep: _build,
     VoxelizeStep: _voxelize,
+    CheckStep: _check,
+    RepairStep: _repair,
     WriteStep: _write,
     ConvertStep: _write,
 }

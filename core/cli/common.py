@@ -357,12 +357,18 @@ def refuse_empty(
 
 
 def read_input(
-    args: argparse.Namespace | Any, path: str | Path, format: str | None = None
+    args: argparse.Namespace | Any,
+    path: str | Path,
+    format: str | None = None,
+    *,
+    repair: bool = True,
 ) -> Scene:
-    """Read a command's input; a file with nothing in it is refused (:func:`refuse_empty`)."""
+    """Read a command's input; a file with nothing in it is refused (:func:`refuse_empty`).
+
+    ``repair=False`` keeps the model as the file holds it (no on-read repairs)."""
     from geobrep.ops.io import read
 
-    scene = read(path, format=format)
+    scene = read(path, format=format, repair=repair)
     if is_empty(scene):
         what = f"{len(scene.entities)} entities, none with geometry" if scene.entities else "none"
         refuse_empty(args, [f"{path}: nothing read (entities: {what})"])

@@ -33,6 +33,8 @@ COMMAND_MODULES = (
     "section",
     "blocks",
     "voxelize",
+    "check",
+    "repair",
     "fit",
     "run",
     "clean",
