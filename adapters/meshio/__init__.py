@@ -27,6 +27,7 @@ from geobrep.adapters._file_format import file_format, full_capabilities
 from geobrep.adapters._vtk_xml import check_vtu_sizes, check_xml_counts
 from geobrep.adapters.cell_layout import (
     ENTITY_ARRAY,
+    HEADER_ARRAY,
     LAYOUT_TYPES,
     header_applies,
     layout_to_scene,
@@ -124,7 +125,9 @@ def _read_legacy(path: Path) -> Scene:
     try:
         mesh = read_mesh(path, "vtk")
     except FormatError:
-        if _pyvista_available():  # VTK reads more of its own format than meshio does
+        # VTK reads more of its own format than meshio does, but its legacy reader can crash
+        # the process on a damaged file: a file meshio wrote (geobrep's) is meshio's to read.
+        if _pyvista_available() and not _written_by_meshio(head):
             return _read_through_pyvista(path)
         raise
     layout = layout_from_mesh(mesh, path)
@@ -132,6 +135,11 @@ def _read_legacy(path: Path) -> Scene:
     if header_applies(header, layout.cell_data):
         layout.header = header
     return layout_to_scene(layout, path)
+
+
+def _written_by_meshio(head: bytes) -> bool:
+    """Whether a legacy file's head says meshio (so geobrep, too) wrote it."""
+    return b"written by meshio" in head[:256] or f"\n{HEADER_ARRAY} ".encode() in head
 
 
 def _pyvista_available() -> bool:
