@@ -1,0 +1,317 @@
+"""A scene as a glTF 2.0 binary (.glb) through pygltflib: one named node and mesh per entity.
+
+Surfaces are TRIANGLES, polylines LINES, point sets POINTS, each with a material of the
+entity's colour (:func:`geobrep.adapters.colors.scene_colours`); every block (but the universe)
+is one more mesh: its closed boundary, coloured by its unit. Positions are float32 in a local
+frame (:mod:`._frame`) kept in the file. Everything else geobrep holds travels exactly in
+``extras.geobrep`` of the nodes and the scene: id, name, kind, metadata, patch labels and
+names, polyline parts, and every property as raw little-endian bytes in a buffer view of the
+binary chunk (float64 stays float64). Each primitive also carries an EXT_mesh_features feature
+id (``_FEATURE_ID_0``) into an EXT_structural_metadata property table of the meshes (name,
+kind, entity id, unit), so 3D Tiles viewers show what a picked object is.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Final
+
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep.adapters.colors import RGBA, scene_colours
+from geobrep.adapters.gltf._frame import Frame, to_y_up
+from geobrep.errors import import_optional
+from geobrep.model.entities import Block, Entity, PointSet, PolyLine, Surface
+from geobrep.model.properties import PropertyMap
+from geobrep.model.scene import Scene
+
+__all__ = ["GEOBREP_KEY", "GlbContent", "build_glb", "write_glb"]
+
+GEOBREP_KEY: Final = "geobrep"
+FORMAT_VERSION: Final = 1
+_FLOAT, _UINT, _USHORT = 5126, 5125, 5123
+_ARRAY_BUFFER, _ELEMENT_BUFFER = 34962, 34963
+_MODES: Final = {"Surface": 4, "PolyLine": 1, "PointSet": 0}
+
+
+def import_pygltflib(feature: str) -> Any:
+    """The ``pygltflib`` module, or :class:`MissingDependencyError` naming the ``web`` extra."""
+    return import_optional("pygltflib", "web", feature)
+
+
+@dataclass
+class _Buffer:
+    """The binary chunk being built: 4-byte aligned buffer views and their accessors."""
+
+    chunks: list[bytes] = field(default_factory=list)
+    size: int = 0
+    views: list[dict[str, Any]] = field(default_factory=list)
+    accessors: list[dict[str, Any]] = field(default_factory=list)
+
+    def view(self, data: bytes, target: int | None = None) -> int:
+        entry: dict[str, Any] = {"buffer": 0, "byteOffset": self.size, "byteLength": len(data)}
+        if target is not None:
+            entry["target"] = target
+        self.views.append(entry)
+        padding = (-len(data)) % 4
+        self.chunks.append(data + b"\0" * padding)
+        self.size += len(data) + padding
+        return len(self.views) - 1
+
+    def raw(self, array: NDArray[Any]) -> dict[str, Any]:
+        """An exact array: its buffer view, little-endian dtype and shape."""
+        values = np.ascontiguousarray(array)
+        little = values.astype(values.dtype.newbyteorder("<"), copy=False)
+        return {
+            "bufferView": self.view(little.tobytes()),
+            "dtype": little.dtype.str,
+            "shape": list(values.shape),
+        }
+
+    def accessor(
+        self, array: NDArray[Any], component: int, kind: str, target: int | None, bounds: bool
+    ) -> int:
+        entry: dict[str, Any] = {
+            "bufferView": self.view(np.ascontiguousarray(array).tobytes(), target),
+            "componentType": component,
+            "count": int(array.shape[0]),
+            "type": kind,
+        }
+        if bounds and array.shape[0]:
+            entry["min"] = [float(v) for v in array.min(axis=0)]
+            entry["max"] = [float(v) for v in array.max(axis=0)]
+        self.accessors.append(entry)
+        return len(self.accessors) - 1
+
+
+@dataclass
+class GlbContent:
+    """What :func:`build_glb` made: the file's bytes and what it measured."""
+
+    data: bytes
+    max_rounding_m: float
+    """Largest distance a vertex moved by the float32 rounding, in world units (metres)."""
+    local_low: NDArray[np.float64]
+    local_high: NDArray[np.float64]
+    meshes: int
+
+
+def _properties(buffer: _Buffer, props: PropertyMap) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for name, prop in props.items():
+        entry = prop.model_dump(mode="json", exclude={"values"})
+        entry.update(buffer.raw(np.asarray(prop.values)))
+        out[name] = entry
+    return out
+
+
+def _entity_extras(buffer: _Buffer, entity: Entity) -> dict[str, Any]:
+    extras: dict[str, Any] = {
+        "type": entity.type,
+        "id": entity.id,
+        "name": entity.name,
+        "kind": entity.kind,
+        "metadata": entity.metadata,
+        "point_data": _properties(buffer, entity.point_data),
+        "cell_data": _properties(buffer, entity.cell_data),
+    }
+    if isinstance(entity, Surface):
+        extras["patch_names"] = list(entity.patch_names)
+        if entity.patch_labels is not None:
+            extras["patch_labels"] = buffer.raw(np.asarray(entity.patch_labels))
+    if isinstance(entity, PolyLine):
+        for name in ("indices", "part_offsets", "closed"):
+            extras[name] = buffer.raw(np.asarray(getattr(entity, name)))
+    if isinstance(entity, Block):
+        extras["unit_name"] = entity.unit_name
+        extras["derived"] = "boundary mesh of the block (not read back as a Block)"
+    return extras
+
+
+def _indices(entity: Entity) -> NDArray[np.uint32] | None:
+    if isinstance(entity, Surface):
+        return np.asarray(entity.faces, np.uint32).ravel()
+    if isinstance(entity, PolyLine):
+        return np.asarray(entity.segments, np.uint32).ravel()
+    return None
+
+
+@dataclass
+class _Meshes:
+    """The glTF objects made so far (JSON dicts) and the extent of the local coordinates."""
+
+    nodes: list[dict[str, Any]] = field(default_factory=list)
+    meshes: list[dict[str, Any]] = field(default_factory=list)
+    materials: list[dict[str, Any]] = field(default_factory=list)
+    rows: list[dict[str, Any]] = field(default_factory=list)
+    rounding: float = 0.0
+    low: NDArray[np.float64] = field(default_factory=lambda: np.full(3, np.inf))
+    high: NDArray[np.float64] = field(default_factory=lambda: np.full(3, -np.inf))
+
+
+def _add_mesh(
+    out: _Meshes,
+    buffer: _Buffer,
+    frame: Frame,
+    geometry: Entity,
+    source: Entity,
+    colour: RGBA,
+) -> None:
+    """One node, mesh and material for ``geometry`` (``source`` is the entity it shows)."""
+    world = np.asarray(geometry.vertices, np.float64)  # type: ignore[attr-defined]
+    local = frame.to_local(world)
+    single = to_y_up(local).astype(np.float32)
+    if len(local):
+        out.rounding = max(
+            out.rounding, float(np.abs(single.astype(np.float64) - to_y_up(local)).max())
+        )
+        out.low = np.minimum(out.low, local.min(axis=0))
+        out.high = np.maximum(out.high, local.max(axis=0))
+    row = len(out.rows)
+    attributes = {
+        "POSITION": buffer.accessor(single, _FLOAT, "VEC3", _ARRAY_BUFFER, True),
+        "_FEATURE_ID_0": buffer.accessor(
+            np.full(len(single), row, np.float32), _FLOAT, "SCALAR", _ARRAY_BUFFER, False
+        ),
+    }
+    primitive: dict[str, Any] = {
+        "attributes": attributes,
+        "mode": _MODES.get(geometry.type, 4),
+        "material": len(out.materials),
+        "extensions": {
+            "EXT_mesh_features": {
+                "featureIds": [{"featureCount": 1, "attribute": 0, "propertyTable": 0}]
+            }
+        },
+    }
+    indices = _indices(geometry)
+    if indices is not None:
+        primitive["indices"] = buffer.accessor(indices, _UINT, "SCALAR", _ELEMENT_BUFFER, False)
+    label = source.name or source.label
+    out.materials.append(
+        {
+            "name": label,
+            "pbrMetallicRoughness": {
+                "baseColorFactor": list(colour),
+                "metallicFactor": 0.0,
+                "roughnessFactor": 0.9,
+            },
+            "doubleSided": True,
+        }
+    )
+    out.meshes.append({"name": label, "primitives": [primitive]})
+    extras = _entity_extras(buffer, source)
+    out.nodes.append({"name": label, "mesh": len(out.meshes) - 1, "extras": {GEOBREP_KEY: extras}})
+    unit = source.unit_name if isinstance(source, Block) else None
+    out.rows.append(
+        {"name": label, "kind": source.kind or "", "entity": source.id, "unit": unit or ""}
+    )
+
+
+def _property_table(buffer: _Buffer, rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """EXT_structural_metadata: a schema and one property table, a row per mesh."""
+    columns: dict[str, Any] = {}
+    for key in ("name", "kind", "unit"):
+        encoded = [str(r[key]).encode("utf-8") for r in rows]
+        offsets = np.concatenate([[0], np.cumsum([len(e) for e in encoded])]).astype(np.uint32)
+        columns[key] = {
+            "values": buffer.view(b"".join(encoded)),
+            "stringOffsets": buffer.view(offsets.tobytes()),
+        }
+    ids = np.array([-1 if r["entity"] is None else r["entity"] for r in rows], np.int32)
+    columns["entity"] = {"values": buffer.view(ids.astype("<i4").tobytes())}
+    return {
+        "schema": {
+            "id": "geobrep",
+            "classes": {
+                "entity": {
+                    "name": "geobrep entity",
+                    "properties": {
+                        "name": {"type": "STRING"},
+                        "kind": {"type": "STRING"},
+                        "unit": {"type": "STRING"},
+                        "entity": {"type": "SCALAR", "componentType": "INT32", "noData": -1},
+                    },
+                }
+            },
+        },
+        "propertyTables": [{"class": "entity", "count": len(rows), "properties": columns}],
+    }
+
+
+def _drawn(scene: Scene, blocks: bool) -> list[tuple[Entity, Entity]]:
+    """(geometry, source) pairs: every mesh entity, then every block's boundary mesh."""
+    pairs: list[tuple[Entity, Entity]] = [
+        (e, e) for e in scene.entities if isinstance(e, Surface | PolyLine | PointSet)
+    ]
+    if blocks:
+        # block meshes cache bounds on the entities: work on copies, not the caller's scene
+        copies = scene.replace(entities=[e.model_copy() for e in scene.entities])
+        for block in copies.blocks:
+            if block is not copies.universe and block.sides:
+                pairs.append((copies.block_mesh(block), block))
+    return pairs
+
+
+def build_glb(
+    scene: Scene,
+    frame: Frame,
+    *,
+    blocks: bool = True,
+    written: Scene | None = None,
+    extras: dict[str, Any] | None = None,
+) -> GlbContent:
+    """The .glb bytes of ``scene`` in ``frame``.
+
+    ``written`` is what the file keeps as entities (``scene`` restricted to the format); the
+    blocks' meshes come from the full ``scene``.
+    """
+    pygltflib = import_pygltflib("writing glTF files")
+    kept = written if written is not None else scene
+    colours = scene_colours(scene)
+    buffer, out = _Buffer(), _Meshes()
+    default = (0.7, 0.7, 0.7, 1.0)
+    for geometry, source in _drawn(scene, blocks):
+        if source is not geometry or source.id in kept.entity_by_id or isinstance(source, Block):
+            colour = default if source.id is None else colours.get(source.id, default)
+            _add_mesh(out, buffer, frame, geometry, source, colour)
+    scene_extras: dict[str, Any] = {
+        "version": FORMAT_VERSION,
+        "name": kept.name,
+        "crs": None if kept.crs is None else kept.crs.model_dump(mode="json"),
+        "metadata": kept.metadata,
+        "groups": [g.model_dump(mode="json") for g in kept.groups],
+        "float32_rounding_m": out.rounding,
+        **frame.describe(),
+        **(extras or {}),
+    }
+    document: dict[str, Any] = {
+        "asset": {"version": "2.0", "generator": "geobrep", "extras": {GEOBREP_KEY: scene_extras}},
+        "scene": 0,
+        "scenes": [{"name": kept.name or "scene", "nodes": list(range(len(out.nodes)))}],
+        "nodes": out.nodes,
+        "meshes": out.meshes,
+        "materials": out.materials,
+    }
+    if out.rows:
+        document["extensionsUsed"] = ["EXT_mesh_features", "EXT_structural_metadata"]
+        document["extensions"] = {"EXT_structural_metadata": _property_table(buffer, out.rows)}
+    document["accessors"] = buffer.accessors
+    document["bufferViews"] = buffer.views
+    document["buffers"] = [{"byteLength": buffer.size}]
+    gltf = pygltflib.GLTF2.from_json(json.dumps(document, allow_nan=False))
+    gltf.set_binary_blob(b"".join(buffer.chunks))
+    data = b"".join(gltf.save_to_bytes())
+    return GlbContent(data, out.rounding, out.low, out.high, len(out.meshes))
+
+
+def write_glb(
+    scene: Scene, path: Path, frame: Frame, *, blocks: bool = True, written: Scene | None = None
+) -> GlbContent:
+    """Write ``scene`` to ``path`` (see :func:`build_glb`)."""
+    content = build_glb(scene, frame, blocks=blocks, written=written)
+    path.write_bytes(content.data)
+    return content

@@ -1,0 +1,282 @@
+"""glTF (.glb) and 3D Tiles: round trips within the float32 error, and what reference readers see.
+
+The float32 bound: positions are stored relative to an origin at the model's centre, so a
+coordinate ``c`` rounds by at most ``|c - origin| * 2**-24`` (half an ulp); the tests check
+every vertex against that bound and against 1 mm.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from formats_support import rich_scene
+
+import geobrep
+from geobrep.errors import FormatError, OptionsError
+from geobrep.host.capabilities import SKIPPED_ON_READ, format_losses
+from geobrep.model.entities import Entity, PointSet, PolyLine, Surface
+from geobrep.model.scene import Scene
+from geobrep.ops.io import read, write
+from geobrep.plugins import registries
+
+pygltflib = pytest.importorskip("pygltflib")
+trimesh = pytest.importorskip("trimesh")
+pyproj = pytest.importorskip("pyproj")
+
+GOCAD = Path(__file__).parent.parent / "data" / "gocad"
+MODEL3D = sorted(GOCAD.glob("*.ml"))
+MILLIMETRE = 1e-3
+
+
+def _bound(vertices: np.ndarray, origin: np.ndarray) -> np.ndarray:
+    """Per vertex: the largest float32 rounding of its coordinates relative to ``origin``."""
+    return np.abs(vertices - origin).max(axis=1) * 2.0**-24 * 1.0000001 + 1e-12
+
+
+def _origin(path: Path) -> np.ndarray:
+    gltf = pygltflib.GLTF2.load(str(path))
+    return np.asarray(gltf.asset.extras["geobrep"]["origin"], np.float64)
+
+
+def _assert_same(original: Entity, back: Entity, origin: np.ndarray) -> None:
+    assert (back.type, back.id, back.name, back.kind) == (
+        original.type,
+        original.id,
+        original.name,
+        original.kind,
+    )
+    assert back.metadata == original.metadata
+    vertices = np.asarray(original.vertices)  # type: ignore[attr-defined]
+    error = np.abs(np.asarray(back.vertices) - vertices).max(axis=1)  # type: ignore[attr-defined]
+    assert (error <= _bound(vertices, origin)).all(), f"{original.label}: {error.max()} m"
+    assert error.max() < MILLIMETRE
+    for field in ("point_data", "cell_data"):
+        assert getattr(back, field) == getattr(original, field), f"{original.label} {field}"
+    if isinstance(original, Surface):
+        assert isinstance(back, Surface)
+        assert np.array_equal(back.faces, original.faces)
+        assert back.patch_names == original.patch_names
+        if original.patch_labels is None:
+            assert back.patch_labels is None
+        else:
+            assert np.array_equal(back.patch_labels, original.patch_labels)
+    if isinstance(original, PolyLine):
+        assert isinstance(back, PolyLine)
+        for name in ("indices", "part_offsets", "closed"):
+            assert np.array_equal(getattr(back, name), getattr(original, name))
+
+
+def _assert_scene(original: Scene, back: Scene, origin: np.ndarray) -> None:
+    kept = [e for e in original.entities if isinstance(e, Surface | PolyLine | PointSet)]
+    assert len(back.entities) == len(kept)
+    for entity, again in zip(kept, back.entities, strict=True):
+        _assert_same(entity, again, origin)
+    assert back.crs == original.crs
+    assert back.name == original.name
+    assert [g.name for g in back.groups] == [g.name for g in original.groups]
+
+
+def test_sample_model_round_trip_within_float32_error(tmp_path: Path) -> None:
+    scene = rich_scene()
+    path = write(scene, tmp_path / "cake.glb")
+    back = read(path)
+    origin = _origin(path)
+    assert np.allclose(origin, scene.bounds.center, atol=0.5)  # type: ignore[union-attr]
+    _assert_scene(scene, back, origin)
+    blocks = [b for b in scene.blocks if b is not scene.universe]
+    skipped = back.metadata[SKIPPED_ON_READ]
+    assert len(skipped) == len(blocks)
+    recorded = pygltflib.GLTF2.load(str(path)).asset.extras["geobrep"]["float32_rounding_m"]
+    measured = max(
+        np.abs(np.asarray(b.vertices) - a.vertices).max()  # type: ignore[attr-defined]
+        for a, b in zip(
+            [e for e in scene.entities if hasattr(e, "vertices") and e.type != "TetMesh"],
+            back.entities,
+            strict=True,
+        )
+    )
+    assert 0 < recorded < MILLIMETRE
+    assert measured <= recorded * 1.01 + 1e-9  # the file says how far it rounded
+
+
+def test_losses_report_what_gltf_cannot_hold() -> None:
+    scene = rich_scene()
+    spec = registries().formats.get("gltf")
+    lost = format_losses(scene, spec, Path("x.glb"))
+    assert "1 TetMesh entities dropped (format holds PointSet, PolyLine, Surface)" in lost
+    assert any("Block entities dropped" in line for line in lost)
+    assert any("topology dropped" in line for line in lost)
+
+
+@pytest.mark.parametrize("path", MODEL3D, ids=lambda p: p.name)
+def test_model3d_files_round_trip(path: Path, tmp_path: Path) -> None:
+    scene = read(path)
+    target = write(scene, tmp_path / "model.glb")
+    _assert_scene(scene, read(target), _origin(target))
+
+
+def test_clipped_model_round_trip(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    centre = scene.bounds.center  # type: ignore[union-attr]
+    clipped = geobrep.clip(scene, geobrep.Plane.from_point_normal(centre, (1.0, 0.3, 0.0)))
+    target = write(clipped, tmp_path / "clipped.glb")
+    back = read(target)
+    _assert_scene(clipped, back, _origin(target))
+    assert len(back.metadata[SKIPPED_ON_READ]) == len(
+        [b for b in clipped.blocks if b is not clipped.universe]
+    )
+
+
+def test_origin_option_and_far_origin_error(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    near = write(scene, tmp_path / "near.glb")
+    far = write(scene, tmp_path / "far.glb", origin=(0.0, 0.0, 0.0))
+    surface = scene.surfaces[0]
+    err_near = np.abs(read(near).surfaces[0].vertices - surface.vertices).max()
+    err_far = np.abs(read(far).surfaces[0].vertices - surface.vertices).max()
+    assert err_near < MILLIMETRE < err_far < 1.0  # UTM northings in float32: ~0.25 m
+    with pytest.raises(OptionsError):
+        write(scene, tmp_path / "bad.glb", origin=(float("nan"), 0.0, 0.0))
+
+
+def test_trimesh_and_pygltflib_read_what_geobrep_wrote(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    path = write(scene, tmp_path / "cake.glb")
+    origin = _origin(path)
+    loaded = trimesh.load(path, force="scene")
+    blocks = [b for b in scene.blocks if b is not scene.universe]
+    assert set(loaded.geometry) == {s.name for s in scene.surfaces} | {b.name for b in blocks}
+    for surface in scene.surfaces:
+        mesh = loaded.geometry[surface.name]
+        y_up = np.asarray(mesh.vertices, np.float64)
+        z_up = np.column_stack([y_up[:, 0], -y_up[:, 2], y_up[:, 1]]) + origin
+        assert np.abs(z_up - surface.vertices).max() < MILLIMETRE
+        assert np.array_equal(np.asarray(mesh.faces), surface.faces)
+    gltf = pygltflib.GLTF2.load(str(path))
+    names = [n.name for n in gltf.nodes]
+    assert names == [s.name for s in scene.surfaces] + [b.name for b in blocks]
+    assert [n.extras["geobrep"]["id"] for n in gltf.nodes][: len(scene.surfaces)] == [
+        s.id for s in scene.surfaces
+    ]
+    colours = [tuple(m.pbrMetallicRoughness.baseColorFactor) for m in gltf.materials]
+    unit_of = {b.name: b.unit_name for b in blocks}
+    by_unit: dict[str | None, set[tuple[float, ...]]] = {}
+    for node in gltf.nodes[len(scene.surfaces) :]:
+        by_unit.setdefault(unit_of[node.name], set()).add(colours[node.mesh])
+    assert all(len(c) == 1 for c in by_unit.values())  # one colour per unit
+    assert len({next(iter(c)) for c in by_unit.values()}) == len(by_unit)
+    metadata = gltf.extensions["EXT_structural_metadata"]
+    assert metadata["propertyTables"][0]["count"] == len(gltf.meshes)
+
+
+def test_model_colours_are_kept(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    red = scene.surfaces[0].replace(metadata={"color": [1.0, 0.0, 0.0]})
+    path = write(scene.replace(entities=[red, *scene.entities[1:]]), tmp_path / "c.glb")
+    gltf = pygltflib.GLTF2.load(str(path))
+    assert gltf.materials[0].pbrMetallicRoughness.baseColorFactor == [1.0, 0.0, 0.0, 1.0]
+
+
+def test_foreign_glb_reads_at_its_node_transform(tmp_path: Path) -> None:
+    box = trimesh.creation.box(extents=(2.0, 4.0, 6.0))
+    world = trimesh.transformations.translation_matrix((10.0, 20.0, 30.0))
+    foreign = trimesh.Scene()
+    foreign.add_geometry(box, node_name="box", geom_name="box", transform=world)
+    path = tmp_path / "foreign.glb"
+    path.write_bytes(foreign.export(file_type="glb"))
+    scene = read(path)
+    (surface,) = scene.surfaces
+    assert surface.n_faces == 12
+    y_up = np.asarray(box.vertices) + np.array([10.0, 20.0, 30.0])
+    expected = np.column_stack([y_up[:, 0], -y_up[:, 2], y_up[:, 1]])
+    assert np.allclose(np.sort(surface.vertices, axis=0), np.sort(expected, axis=0), atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("damage", "message"),
+    [
+        (lambda data: b"nope" + data[4:], "magic"),
+        (lambda data: data[: len(data) // 2], "glTF|outside the binary chunk"),
+    ],
+)
+def test_bad_files_are_format_errors(damage: object, message: str, tmp_path: Path) -> None:
+    good = write(geobrep.datasets.faulted_layer_cake(), tmp_path / "good.glb")
+    bad = tmp_path / "bad.glb"
+    bad.write_bytes(damage(good.read_bytes()))  # type: ignore[operator]
+    with pytest.raises(FormatError, match=message):
+        read(bad, format="gltf")
+
+
+def test_accessor_outside_the_chunk_is_a_format_error(tmp_path: Path) -> None:
+    good = write(geobrep.datasets.faulted_layer_cake(), tmp_path / "good.glb")
+    gltf = pygltflib.GLTF2.load(str(good))
+    gltf.accessors[0].count = 10**9
+    bad = tmp_path / "bad.glb"
+    gltf.save_binary(str(bad))
+    with pytest.raises(FormatError, match="past its buffer view"):
+        read(bad)
+
+
+# -- 3D Tiles ------------------------------------------------------------------------------
+
+
+def _ecef(scene: Scene, points: np.ndarray) -> np.ndarray:
+    crs = pyproj.CRS.from_epsg(scene.crs.epsg).to_3d()  # type: ignore[union-attr]
+    to_ecef = pyproj.Transformer.from_crs(crs, "EPSG:4978", always_xy=True)
+    return np.column_stack(to_ecef.transform(*points.T))
+
+
+def test_tileset_places_the_model_at_its_true_ecef_position(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    tileset = write(scene, tmp_path / "tileset.json")
+    document = json.loads(tileset.read_text())
+    assert document["asset"]["version"] == "1.1"
+    root = document["root"]
+    assert root["content"]["uri"] == "tileset.glb"
+    matrix = np.asarray(root["transform"], np.float64).reshape(4, 4).T  # column-major
+    content = trimesh.load(tmp_path / "tileset.glb", force="scene")
+    for surface in scene.surfaces:
+        y_up = np.asarray(content.geometry[surface.name].vertices, np.float64)
+        z_up = np.column_stack([y_up[:, 0], -y_up[:, 2], y_up[:, 1]])  # what 3D Tiles does
+        placed = z_up @ matrix[:3, :3].T + matrix[:3, 3]
+        assert np.abs(placed - _ecef(scene, surface.vertices)).max() < MILLIMETRE
+    back = read(tileset)
+    for original, again in zip(scene.surfaces, back.surfaces, strict=True):
+        assert np.abs(again.vertices - original.vertices).max() < MILLIMETRE
+        assert again.name == original.name
+    box = np.asarray(root["boundingVolume"]["box"])
+    assert np.all(box[[3, 7, 11]] > 0)
+
+
+def test_tileset_of_a_local_model_needs_a_georeference(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake().replace(crs=None)
+    with pytest.raises(OptionsError, match="no CRS"):
+        write(scene, tmp_path / "tileset.json")
+    with pytest.raises(OptionsError, match="go together"):
+        write(scene, tmp_path / "tileset.json", longitude=2.0)
+    tileset = write(scene, tmp_path / "tileset.json", longitude=2.35, latitude=48.85, height=35.0)
+    matrix = np.asarray(json.loads(tileset.read_text())["root"]["transform"]).reshape(4, 4).T
+    to_ecef = pyproj.Transformer.from_crs("EPSG:4979", "EPSG:4978", always_xy=True)
+    assert np.allclose(matrix[:3, 3], to_ecef.transform(2.35, 48.85, 35.0), atol=1e-6)
+    back = read(tileset)
+    assert np.abs(back.surfaces[0].vertices - scene.surfaces[0].vertices).max() < MILLIMETRE
+    with pytest.raises(OptionsError, match="has a CRS"):
+        write(
+            geobrep.datasets.faulted_layer_cake(),
+            tmp_path / "t.json",
+            longitude=2.35,
+            latitude=48.85,
+            height=35.0,
+        )
+
+
+def test_tileset_content_outside_its_folder_is_refused(tmp_path: Path) -> None:
+    tileset = write(geobrep.datasets.faulted_layer_cake(), tmp_path / "tileset.json")
+    document = json.loads(tileset.read_text())
+    document["root"]["content"]["uri"] = "../elsewhere.glb"
+    tileset.write_text(json.dumps(document))
+    with pytest.raises(FormatError, match="beside the tileset"):
+        read(tileset)
