@@ -47,6 +47,17 @@ sysdeps:
 	    echo "(everything else works without it)"; \
 	  fi; \
 	fi
+	@if ! command -v chromium >/dev/null 2>&1 && ! command -v chromium-browser >/dev/null 2>&1; then \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    echo "installing chromium (the browser test of geobrep view)"; \
+	    apt-get install -y -qq chromium >/dev/null 2>&1 || \
+	      { apt-get update -qq >/dev/null && apt-get install -y -qq chromium >/dev/null; } || \
+	      echo "could not install chromium: the browser test will be skipped"; \
+	  else \
+	    echo "the browser test of geobrep view needs Chromium. Install it with:"; \
+	    echo "    sudo apt-get install chromium    # Debian/Ubuntu"; \
+	  fi; \
+	fi
 
 $(STAMPS)/demo: pyproject.toml $(STAMPS)/base
 	$(PY) -m pip install $(PIP_QUIET) -e ".[viz,gis]"

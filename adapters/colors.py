@@ -49,7 +49,9 @@ def scene_colours(scene: Scene) -> dict[int, RGBA]:
     """A colour per entity id: its own, else the palette's (blocks: one colour per unit)."""
     colours: dict[int, RGBA] = {}
     slots: dict[str, int] = {}
-    for entity in scene.entities:
+    # blocks first: the units take the first, most distinct colours
+    ordered = sorted(scene.entities, key=lambda e: not isinstance(e, Block))
+    for entity in ordered:
         if entity.id is None:
             continue
         own = entity_colour(entity)

@@ -143,6 +143,7 @@ class EnuFrame:
     def describe(self) -> dict[str, Any]:
         return {
             "frame": "enu",
+            "placed_by": "crs" if self.crs is not None else "georeference",
             "origin": list(self.anchor),
             "geodetic_origin": list(self.geodetic),
             "ecef_origin": list(self.ecef_origin),

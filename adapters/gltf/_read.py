@@ -113,7 +113,8 @@ def _frame(extras: dict[str, Any], crs: CRS | None, path: Path) -> Frame:
         if extras.get("frame") == "enu":
             geodetic = tuple(float(v) for v in extras["geodetic_origin"])
             ecef = tuple(float(v) for v in extras["ecef_origin"])
-            return EnuFrame(origin, crs, geodetic, ecef)  # type: ignore[arg-type]
+            placed_by_crs = extras.get("placed_by", "crs") == "crs"
+            return EnuFrame(origin, crs if placed_by_crs else None, geodetic, ecef)  # type: ignore[arg-type]
     except (KeyError, TypeError, ValueError) as exc:
         raise FormatError(f"bad frame in extras.geobrep: {exc}", path) from exc
     if len(origin) != 3:

@@ -19,6 +19,7 @@ from geobrep.adapters.gltf._frame import EnuFrame
 from geobrep.adapters.gltf._read import read_glb
 from geobrep.adapters.gltf._write import GEOBREP_KEY, build_glb
 from geobrep.errors import FormatError, OptionsError
+from geobrep.model.crs import CRS, CRSError
 from geobrep.model.scene import Scene
 from geobrep.ops.io import atomic_write
 from geobrep.ops.temporaries import parse_temporary
@@ -36,27 +37,48 @@ def _centre(scene: Scene) -> tuple[float, float, float]:
     return float(centre[0]), float(centre[1]), float(centre[2])
 
 
+def _placeable(crs: CRS | None) -> bool:
+    """True for a CRS pyproj can put on the globe (projected or geographic); a CRS known only
+    by its name (GOCAD's 'Default', 'gocad Local') is a local one and is not looked up."""
+    if crs is None or (crs.epsg is None and crs.wkt is None and crs.proj is None):
+        return False
+    from geobrep.gis.crs_ops import parse_crs
+
+    try:
+        parsed = parse_crs(crs)
+    except CRSError:
+        return False
+    return bool(parsed.is_projected or parsed.is_geographic)
+
+
 def tiles_frame(
     scene: Scene, longitude: float | None, latitude: float | None, height: float | None
 ) -> EnuFrame:
     """The ENU frame of ``scene``: from its CRS, or from the georeference the user gave."""
     given = [v is not None for v in (longitude, latitude, height)]
+    if any(given) and not all(given):
+        raise OptionsError("longitude, latitude and height go together")
     anchor = _centre(scene)
+    placeable = _placeable(scene.crs)
     if all(given):
-        if scene.crs is not None:
+        if placeable:
             raise OptionsError(
-                f"the scene has a CRS ({scene.crs.label}), which places it: longitude, latitude "
+                f"the scene's CRS ({scene.crs.label}) places it: longitude, latitude "  # type: ignore[union-attr]
                 "and height are for a model in a local or unknown CRS"
             )
         return EnuFrame.from_geodetic(anchor, float(longitude), float(latitude), float(height))  # type: ignore[arg-type]
-    if any(given):
-        raise OptionsError("longitude, latitude and height go together")
-    if scene.crs is None:
-        raise OptionsError(
-            "3D Tiles need the model's place on the globe: the scene has no CRS. Give one "
-            "(geobrep reproject / Scene(crs=...)) or the georeference of the model's centre: "
-            "longitude=..., latitude=..., height=... (degrees, degrees, metres)"
+    if not placeable:
+        which = (
+            "has no CRS"
+            if scene.crs is None
+            else f"is in a local or unknown CRS ({scene.crs.label})"
         )
+        raise OptionsError(
+            f"3D Tiles need the model's place on the globe: the scene {which}. Give a "
+            "projected or geographic CRS (an EPSG code or WKT) or the georeference of the "
+            "model's centre: longitude=..., latitude=..., height=... (degrees, degrees, metres)"
+        )
+    assert scene.crs is not None
     return EnuFrame.from_crs(scene.crs, anchor)
 
 

@@ -22,9 +22,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.colors import RGBA, scene_colours
+from geobrep.adapters.display import drawn_meshes
 from geobrep.adapters.gltf._frame import Frame, to_y_up
 from geobrep.errors import import_optional
-from geobrep.model.entities import Block, Entity, PointSet, PolyLine, Surface
+from geobrep.model.entities import Block, Entity, PolyLine, Surface
 from geobrep.model.properties import PropertyMap
 from geobrep.model.scene import Scene
 
@@ -242,20 +243,6 @@ def _property_table(buffer: _Buffer, rows: list[dict[str, Any]]) -> dict[str, An
     }
 
 
-def _drawn(scene: Scene, blocks: bool) -> list[tuple[Entity, Entity]]:
-    """(geometry, source) pairs: every mesh entity, then every block's boundary mesh."""
-    pairs: list[tuple[Entity, Entity]] = [
-        (e, e) for e in scene.entities if isinstance(e, Surface | PolyLine | PointSet)
-    ]
-    if blocks:
-        # block meshes cache bounds on the entities: work on copies, not the caller's scene
-        copies = scene.replace(entities=[e.model_copy() for e in scene.entities])
-        for block in copies.blocks:
-            if block is not copies.universe and block.sides:
-                pairs.append((copies.block_mesh(block), block))
-    return pairs
-
-
 def build_glb(
     scene: Scene,
     frame: Frame,
@@ -274,7 +261,7 @@ def build_glb(
     colours = scene_colours(scene)
     buffer, out = _Buffer(), _Meshes()
     default = (0.7, 0.7, 0.7, 1.0)
-    for geometry, source in _drawn(scene, blocks):
+    for geometry, source in drawn_meshes(scene, blocks):
         if source is not geometry or source.id in kept.entity_by_id or isinstance(source, Block):
             colour = default if source.id is None else colours.get(source.id, default)
             _add_mesh(out, buffer, frame, geometry, source, colour)

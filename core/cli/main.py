@@ -28,6 +28,7 @@ COMMAND_MODULES = (
     "demo",
     "convert",
     "render",
+    "view",
     "reproject",
     "clip",
     "section",

@@ -333,6 +333,7 @@ def test_no_python_warning_text_on_stderr(tmp_path: Path) -> None:
         ],
         "run": ["run", pipeline],
         "plugins": ["plugins"],
+        "view": ["view", MODEL_A1, "-o", tmp_path / "model.html"],
     }
     if importlib.util.find_spec("pyvista") is not None:
         commands["render"] = ["render", MODEL_A1, tmp_path / "model.png"]

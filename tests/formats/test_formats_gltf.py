@@ -263,7 +263,7 @@ def test_tileset_of_a_local_model_needs_a_georeference(tmp_path: Path) -> None:
     assert np.allclose(matrix[:3, 3], to_ecef.transform(2.35, 48.85, 35.0), atol=1e-6)
     back = read(tileset)
     assert np.abs(back.surfaces[0].vertices - scene.surfaces[0].vertices).max() < MILLIMETRE
-    with pytest.raises(OptionsError, match="has a CRS"):
+    with pytest.raises(OptionsError, match="places it"):
         write(
             geobrep.datasets.faulted_layer_cake(),
             tmp_path / "t.json",
@@ -280,3 +280,16 @@ def test_tileset_content_outside_its_folder_is_refused(tmp_path: Path) -> None:
     tileset.write_text(json.dumps(document))
     with pytest.raises(FormatError, match="beside the tileset"):
         read(tileset)
+
+
+def test_tileset_of_a_gocad_local_crs_takes_the_georeference(tmp_path: Path) -> None:
+    scene = read(GOCAD / "modelA1.ml")
+    assert scene.crs is not None
+    assert scene.crs.epsg is None  # GOCAD's "Default"
+    with pytest.raises(OptionsError, match="local or unknown CRS"):
+        write(scene, tmp_path / "tileset.json")
+    tileset = write(scene, tmp_path / "tileset.json", longitude=7.0, latitude=46.0, height=500.0)
+    back = read(tileset)
+    assert back.crs == scene.crs
+    for original, again in zip(scene.surfaces, back.surfaces, strict=True):
+        assert np.abs(again.vertices - original.vertices).max() < MILLIMETRE
