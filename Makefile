@@ -10,7 +10,7 @@ STAMPS := $(VENV)/.geobrep-stamps
 EXAMPLE_PLUGIN := docs/examples/geobrep-example-plugin
 PIP_QUIET := --quiet --disable-pip-version-check
 
-.PHONY: demo test test-newest test-min lint typecheck pytest bench fuzz schemas sysdeps clean help
+.PHONY: demo test test-newest test-min lint typecheck pytest bench fuzz schemas sysdeps clean help geoh5-check
 
 help:
 	@echo "make demo   - run the demo on the built-in sample model (writes demo-output/)"
@@ -18,6 +18,7 @@ help:
 	@echo "make test-min - the suite on the lowest versions pyproject.toml allows (.venv-min)"
 	@echo "make bench  - benchmarks (not part of make test)"
 	@echo "make fuzz   - 25,000 mutated files through every reader (not part of make test)"
+	@echo "make geoh5-check - cross-check the geoh5 adapter with geoh5py in a venv of its own"
 
 $(PY):
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "geobrep needs Python 3.11 or newer: set PYTHON=python3.11 (or newer)")'
@@ -117,6 +118,21 @@ $(MIN_STAMP): pyproject.toml tools/floors.py
 test-min: $(MIN_STAMP) sysdeps
 	@$(MIN_PY) -c 'import numpy, rtree, scipy; print(f"floors: numpy {numpy.__version__}, rtree {rtree.__version__}, scipy {scipy.__version__} (all pins: $(MIN_VENV)/installed.txt)")'
 	$(MIN_PY) -m pytest -p no:cacheprovider
+
+# geoh5py pins numpy<1.27 and cannot share .venv: it gets a venv of its own, and the check runs
+# in three steps (geobrep writes, geoh5py reads it and writes, geobrep reads that): tools/geoh5_check.py.
+GEOH5_VENV ?= .venv-geoh5
+GEOH5_DIR  ?= build/geoh5-check
+$(GEOH5_VENV)/.geoh5py: Makefile
+	rm -rf $(GEOH5_VENV)
+	$(PYTHON) -m venv $(GEOH5_VENV)
+	$(GEOH5_VENV)/bin/python -m pip install $(PIP_QUIET) "geoh5py>=0.12,<0.14" "numpy>=1.26,<1.27"
+	@touch $@
+
+geoh5-check: $(STAMPS)/test $(GEOH5_VENV)/.geoh5py
+	$(PY) tools/geoh5_check.py write $(GEOH5_DIR)
+	$(GEOH5_VENV)/bin/python tools/geoh5_check.py geoh5py $(GEOH5_DIR)
+	$(PY) tools/geoh5_check.py read $(GEOH5_DIR)
 
 schemas: $(STAMPS)/base
 	$(PY) -m geobrep.schemas

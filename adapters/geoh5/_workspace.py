@@ -1,0 +1,300 @@
+"""geoh5 workspaces (Geoscience ANALYST, format version 2) on h5py, from the published schema.
+
+A workspace is one HDF5 group ``GEOSCIENCE``: ``Groups``, ``Objects`` and ``Data`` hold one
+HDF5 group per entity named by its ``{uuid}``, ``Types`` one group per entity type, and
+``Root`` is the workspace group. An object links its ``Type`` and its ``Data``; a data group
+holds its values as ``Data`` and its association (``Vertex``, ``Cell``) as an attribute.
+Points, Curve (segments as ``Cells``), Surface (triangles as ``Cells``) and BlockModel (cell
+delimiters along u, v and z, cells ordered v slowest, z fastest) are read and written.
+"""
+
+from __future__ import annotations
+
+import math
+import uuid
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep.adapters._grid_cells import Grid, triple
+from geobrep.adapters.cell_layout import chain_segments
+from geobrep.adapters.limits import check_declared
+from geobrep.errors import FormatError, GeobrepError
+from geobrep.host.capabilities import SKIPPED_ON_READ
+from geobrep.model.entities import Entity, PointSet, PolyLine, Surface
+from geobrep.model.properties import PropertyMap
+from geobrep.model.scene import Scene
+
+__all__ = ["OBJECT_TYPES", "read_geoh5", "write_geoh5"]
+
+#: geoh5 object type uuids (fixed by the schema) and names.
+OBJECT_TYPES = {
+    "Points": "{202C5DB1-A56D-4004-9CAD-BAAFD8899406}",
+    "Curve": "{6A057FDC-B355-11E3-95BE-FD84A7FFCB88}",
+    "Surface": "{F26FEBA3-ADED-494B-B9E9-B2BBCBE298E1}",
+    "Block model": "{B020A277-90E2-4CD7-84D6-612EE3F25051}",
+}
+_BY_TYPE = {v.lower(): k for k, v in OBJECT_TYPES.items()}
+_ROOT_TYPE = "{dd99b610-be92-48c0-873c-5b5946ea2840}"
+_ENTITY_FLAGS = {"Allow delete": 1, "Allow move": 1, "Allow rename": 1, "Public": 1, "Visible": 1}
+_XYZ = np.dtype([("x", "<f8"), ("y", "<f8"), ("z", "<f8")])
+
+
+def _uid() -> str:
+    return "{" + str(uuid.uuid4()) + "}"
+
+
+# -- writing ------------------------------------------------------------------------------------
+
+
+def _workspace(store: h5py.File, name: str) -> h5py.Group:
+    root = store.create_group("GEOSCIENCE")
+    root.attrs.update({"Version": 2.0, "Distance unit": "meter", "GA Version": "1"})
+    root.attrs["Contributors"] = np.array(["geobrep"], dtype=h5py.string_dtype())
+    for folder in (
+        "Data",
+        "Groups",
+        "Objects",
+        "Types/Data types",
+        "Types/Group types",
+        "Types/Object types",
+    ):
+        root.create_group(folder, track_order=True)  # objects read back in the order written
+    ident = _uid()
+    group = root["Groups"].create_group(ident)
+    group.attrs.update({"ID": ident, "Name": name or "Workspace", **_ENTITY_FLAGS})
+    for folder in ("Data", "Groups", "Objects"):
+        group.create_group(folder, track_order=True)
+    kind = root["Types/Group types"].create_group(_ROOT_TYPE)
+    kind.attrs.update({"ID": _ROOT_TYPE, "Name": "NoType", "Description": "<Unknown>"})
+    group["Type"] = kind
+    root["Root"] = group
+    return root
+
+
+def _object_type(root: h5py.Group, name: str) -> h5py.Group:
+    ident = OBJECT_TYPES[name]
+    types = root["Types/Object types"]
+    if ident not in types:
+        types.create_group(ident).attrs.update({"ID": ident, "Name": name, "Description": name})
+    return types[ident]
+
+
+def _write_data(root: h5py.Group, obj: h5py.Group, props: PropertyMap, association: str) -> None:
+    for name, prop in props.items():
+        values = np.asarray(prop.values)
+        if values.ndim != 1 or values.dtype.kind not in "biuf":
+            continue  # vectors: reported as lost
+        primitive = "Float" if values.dtype.kind == "f" else "Integer"
+        stored = values.astype(np.float64 if primitive == "Float" else np.int32)
+        ident, type_ident = _uid(), _uid()
+        data = root["Data"].create_group(ident)
+        data.attrs.update({"ID": ident, "Name": name, "Association": association, **_ENTITY_FLAGS})
+        data.create_dataset("Data", data=stored)
+        kind = root["Types/Data types"].create_group(type_ident)
+        kind.attrs.update(
+            {
+                "ID": type_ident,
+                "Name": name,
+                "Description": prop.description or name,
+                "Primitive type": primitive,
+            }
+        )
+        data["Type"] = kind
+        obj["Data"][ident] = data
+
+
+def _vertices(points: NDArray[np.float64]) -> NDArray[Any]:
+    rows = np.empty(len(points), dtype=_XYZ)
+    rows["x"], rows["y"], rows["z"] = points[:, 0], points[:, 1], points[:, 2]
+    return rows
+
+
+def _rotation(grid: Grid) -> float:
+    """The z rotation (degrees) of a grid whose axes are rotated in plan only."""
+    u, v, w = (np.asarray(a) for a in grid.axes)
+    angle = math.degrees(math.atan2(u[1], u[0]))
+    expected = np.array([[math.cos(math.radians(angle)), math.sin(math.radians(angle)), 0.0]])
+    if not (
+        np.allclose(u, expected[0]) and np.allclose(np.cross(u, v), w) and np.allclose(w, [0, 0, 1])
+    ):
+        raise FormatError(f"geoh5 block models rotate about z only; axes {grid.axes} do not")
+    return 0.0 if grid.axes[0] == (1.0, 0.0, 0.0) else angle
+
+
+def _write_object(root: h5py.Group, entity: Entity) -> None:
+    grid = Grid.of(entity)
+    kind = (
+        "Block model"
+        if grid
+        else {"Surface": "Surface", "PolyLine": "Curve"}.get(entity.type, "Points")
+    )
+    ident = _uid()
+    obj = root["Objects"].create_group(ident)
+    obj.attrs.update(
+        {"ID": ident, "Name": entity.name or entity.label, "Last focus": "None", **_ENTITY_FLAGS}
+    )
+    obj.create_group("Data", track_order=True)
+    obj["Type"] = _object_type(root, kind)
+    root["Root"]["Objects"][ident] = obj
+    if grid is not None:
+        origin = np.array([tuple(grid.origin)], dtype=_XYZ)[0]
+        obj.attrs["Origin"] = origin
+        obj.attrs["Rotation"] = _rotation(grid)
+        for axis, sizes in zip("UVZ", grid.sizes, strict=True):
+            obj.create_dataset(
+                f"{axis} cell delimiters", data=np.concatenate([[0.0], np.cumsum(sizes)])
+            )
+        order = _geoh5_order(grid.shape)
+        values = {
+            n: {"values": np.asarray(p.values)[order], "description": p.description}
+            for n, p in entity.point_data.items()
+        }
+        _write_data(root, obj, PropertyMap(values), "Cell")
+        return
+    assert isinstance(entity, PointSet | PolyLine | Surface)
+    obj.create_dataset("Vertices", data=_vertices(entity.vertices))
+    if isinstance(entity, Surface):
+        obj.create_dataset("Cells", data=np.asarray(entity.faces, dtype=np.int32))
+    elif isinstance(entity, PolyLine):
+        obj.create_dataset("Cells", data=np.asarray(entity.segments, dtype=np.uint32))
+    _write_data(root, obj, entity.point_data, "Vertex")
+    if isinstance(entity, Surface | PolyLine):
+        _write_data(root, obj, entity.cell_data, "Cell")
+
+
+def _geoh5_order(shape: tuple[int, int, int]) -> NDArray[np.int64]:
+    """For each geoh5 cell (v slowest, z fastest), the index of the same cell u fastest."""
+    nu, nv, nw = shape
+    v, u, w = np.meshgrid(np.arange(nv), np.arange(nu), np.arange(nw), indexing="ij")
+    return (u + nu * (v + nv * w)).ravel()
+
+
+def write_geoh5(scene: Scene, path: Path) -> None:
+    """Write ``scene`` as the geoh5 workspace ``path``."""
+    for surface in scene.surfaces:
+        if surface.faces.shape[1] != 3:
+            raise FormatError(
+                f"{surface.label}: geoh5 surfaces hold triangles; triangulate its quads"
+            )
+    with h5py.File(path, "w") as store:
+        root = _workspace(store, scene.name)
+        for entity in scene.entities:
+            _write_object(root, entity)
+
+
+# -- reading ------------------------------------------------------------------------------------
+
+
+def _text(value: Any) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _check_sizes(store: h5py.File, path: Path) -> None:
+    total = 0
+
+    def add(name: str, item: Any) -> None:
+        nonlocal total
+        if isinstance(item, h5py.Dataset):
+            total += int(item.size) * item.dtype.itemsize
+
+    store.visititems(add)
+    check_declared(total, path.stat().st_size, "its datasets", path)
+
+
+def _read_data(obj: h5py.Group, association: str, n: int, order: Any = None) -> PropertyMap:
+    found = {}
+    for data in obj.get("Data", {}).values():
+        if _text(data.attrs.get("Association", "")) != association or "Data" not in data:
+            continue
+        values = np.asarray(data["Data"][()])
+        if values.ndim != 1 or values.dtype.kind not in "biuf" or len(values) != n:
+            continue
+        kind = data.get("Type")
+        description = "" if kind is None else _text(kind.attrs.get("Description", ""))
+        name = _text(data.attrs.get("Name", ""))
+        found[name] = {
+            "values": values if order is None else values[order],
+            "description": "" if description in (name, "Entity") else description,
+        }
+    return PropertyMap(found)
+
+
+def _xyz(obj: h5py.Group) -> NDArray[np.float64]:
+    rows = obj["Vertices"][()]
+    if rows.dtype.names:
+        return np.column_stack([rows[k] for k in ("x", "y", "z")]).astype(np.float64)
+    return np.asarray(rows, dtype=np.float64).reshape(-1, 3)
+
+
+def _block_model(obj: h5py.Group, name: str) -> Entity:
+    origin = obj.attrs["Origin"]
+    corner = np.array([origin["x"], origin["y"], origin["z"]], dtype=np.float64)
+    delimiters = [np.asarray(obj[f"{a} cell delimiters"][()], dtype=np.float64) for a in "UVZ"]
+    angle = math.radians(float(obj.attrs.get("Rotation", 0.0)))
+    axes = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    if angle:
+        c, s = math.cos(angle), math.sin(angle)
+        axes = ((c, s, 0.0), (-s, c, 0.0), (0.0, 0.0, 1.0))
+    start = np.array([d[0] for d in delimiters])
+    corner = corner + start @ np.asarray(axes) if start.any() else corner
+    grid = Grid(origin=triple(corner), sizes=tuple(np.diff(d) for d in delimiters), axes=axes)  # type: ignore[arg-type]
+    order = np.argsort(_geoh5_order(grid.shape))
+    return grid.point_set(name, point_data=_read_data(obj, "Cell", grid.n_cells, order))
+
+
+def _object(obj: h5py.Group) -> Entity | None:
+    kind = _BY_TYPE.get(_text(obj["Type"].attrs.get("ID", "")).lower())
+    name = _text(obj.attrs.get("Name", ""))
+    if kind == "Block model":
+        return _block_model(obj, name)
+    if kind is None or "Vertices" not in obj:
+        return None
+    vertices = _xyz(obj)
+    points = _read_data(obj, "Vertex", len(vertices))
+    if kind == "Points":
+        return PointSet(vertices=vertices, name=name, point_data=points)
+    cells = (
+        np.asarray(obj["Cells"][()], dtype=np.int64)
+        if "Cells" in obj
+        else np.zeros((0, 3), np.int64)
+    )
+    cell_data = _read_data(obj, "Cell", len(cells))
+    if kind == "Surface":
+        return Surface(
+            vertices=vertices, faces=cells, name=name, point_data=points, cell_data=cell_data
+        )
+    return chain_segments(
+        vertices, cells.reshape(-1, 2), cell_data, {"name": name, "point_data": points}
+    )
+
+
+def read_geoh5(path: Path) -> Scene:
+    """The scene of the geoh5 workspace ``path``."""
+    try:
+        with h5py.File(path, "r") as store:
+            _check_sizes(store, path)
+            if "GEOSCIENCE" not in store:
+                raise FormatError("not a geoh5 workspace (no GEOSCIENCE group)", path)
+            root = store["GEOSCIENCE"]
+            entities, skipped = [], []
+            for ident, obj in root.get("Objects", {}).items():
+                try:
+                    entity = _object(obj)
+                except GeobrepError as exc:
+                    raise FormatError(f"object {ident}: {exc}", path) from exc
+                if entity is None:
+                    label = _text(obj.attrs.get("Name", ident))
+                    skipped.append(f"geoh5 object {label!r}: no reader for its type")
+                else:
+                    entities.append(entity)
+            name = _text(root["Root"].attrs.get("Name", path.stem)) if "Root" in root else path.stem
+    except GeobrepError:
+        raise
+    except Exception as exc:  # h5py and damaged attributes
+        raise FormatError(f"damaged geoh5 workspace ({type(exc).__name__}: {exc})", path) from exc
+    metadata: dict[str, Any] = {SKIPPED_ON_READ: skipped} if skipped else {}
+    return Scene(entities=entities, name="" if name == "Workspace" else name, metadata=metadata)
