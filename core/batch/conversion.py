@@ -574,7 +574,7 @@ def _run_dask(
 
 
 def demo_stage(ctx: Any) -> None:
-    """Demo: a picture of the model, and the model converted to .vtu and .ply."""
+    """Demo: the model converted to .vtu and .ply, a picture with a legend, and a web page."""
     from geobrep.host import registries
 
     formats = registries().formats
@@ -608,4 +608,16 @@ def demo_stage(ctx: Any) -> None:
     else:
         section["picture"] = None
         ctx.lines.append("render: skipped (install geobrep[viz] for pictures)")
+    section["page"] = _demo_page(ctx, formats)
     ctx.summary["conversion"] = section
+
+
+def _demo_page(ctx: Any, formats: Any) -> str | None:
+    """Demo: ``layer_cake.html``, the model to look at in a browser (``geobrep view``)."""
+    page = ctx.output / "layer_cake.html"
+    if "html" not in formats:
+        ctx.lines.append("view: skipped (format 'html' not installed)")
+        return None
+    write(ctx.scene, page, format="html")
+    ctx.lines.append(f"view: {page.name} (open it in a browser: no server needed)")
+    return str(page.name)

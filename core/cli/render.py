@@ -1,7 +1,8 @@
 """``geobrep render SCENE out.png``: a picture of a model, off-screen (no display needed).
 
 Colour by entity, block or property, optionally cutting away the side of a plane its normal
-points to. Rendering goes through the registered ``png`` format (pyvista, extra ``viz``).
+points to or drawing a section; a legend, axes in world coordinates, a scale bar and the CRS in
+the title. Rendering goes through the registered ``png`` format (pyvista, extra ``viz``).
 """
 
 from __future__ import annotations
@@ -55,6 +56,39 @@ def add_parser(subparsers: Any) -> None:
         help="normal of the cut-away plane (the side it points to is removed)",
     )
     parser.add_argument(
+        "--section-origin", type=_triple, metavar="X,Y,Z", help="a point of the section plane"
+    )
+    parser.add_argument(
+        "--section-normal",
+        type=_triple,
+        metavar="NX,NY,NZ",
+        help="normal of the section plane: the side it points to is removed, blocks are "
+        "closed by the cut, and the picture looks at the cut",
+    )
+    parser.add_argument(
+        "--view",
+        choices=("isometric", "top", "bottom", "north", "south", "east", "west"),
+        help="where the camera looks from (default: isometric, or square to the section)",
+    )
+    parser.add_argument(
+        "--azimuth",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="turn the camera about the vertical by DEG degrees",
+    )
+    parser.add_argument(
+        "--elevation",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="raise the camera by DEG degrees",
+    )
+    parser.add_argument("--title", help="the picture's title (default: model name and CRS)")
+    parser.add_argument("--no-legend", action="store_true", help="no legend of names and colours")
+    parser.add_argument("--no-axes", action="store_true", help="no axes with coordinates")
+    parser.add_argument("--no-scale-bar", action="store_true", help="no scale bar")
+    parser.add_argument(
         "--size",
         type=int,
         nargs=2,
@@ -71,6 +105,8 @@ def add_parser(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     if (args.clip_origin is None) != (args.clip_normal is None):
         raise OptionsError("--clip-origin and --clip-normal go together")
+    if (args.section_origin is None) != (args.section_normal is None):
+        raise OptionsError("--section-origin and --section-normal go together")
     color_by = args.color_by or ("property" if args.property else "entity")
     scene = read_input(args, args.scene, format=args.format)
     path = write(
@@ -84,6 +120,15 @@ def run(args: argparse.Namespace) -> int:
         window_size=tuple(args.size),
         show_edges=args.edges,
         vertical_exaggeration=args.vertical_exaggeration,
+        section_origin=args.section_origin,
+        section_normal=args.section_normal,
+        view=args.view,
+        azimuth=args.azimuth,
+        elevation=args.elevation,
+        title=args.title,
+        legend=not args.no_legend,
+        axes=not args.no_axes,
+        scale_bar=not args.no_scale_bar,
     )
     print(f"wrote {path}")
     return 0

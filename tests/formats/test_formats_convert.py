@@ -178,3 +178,6 @@ def test_demo_stage_writes_picture_and_conversions(layer_cake: Scene, tmp_path: 
     assert any("Block" in line for line in section["ply"]["lost"])
     assert any(line.startswith("render: layer_cake.png") for line in ctx.lines)
     assert not (tmp_path / "conversion_source.geobrep").exists()
+    page = (tmp_path / "layer_cake.html").read_text()
+    assert section["page"] == "layer_cake.html"
+    assert all(f'"name": "{b.name}"' in page for b in layer_cake.blocks if b.kind != "universe")
