@@ -58,9 +58,10 @@ def _neighbour_pairs(faces: IntArray) -> tuple[IntArray, IntArray, BoolArray]:
 def _labels(n: int, a: IntArray, b: IntArray) -> IntArray:
     """The lowest node of each node's component, nodes ``0 … n-1`` joined by pairs (a, b).
 
-    Hooking of the higher root onto the lower, then pointer jumping to the roots: each pass at
-    least halves the number of components that still have a link, so O(log n) passes of
-    numpy work (no Python loop per node or pair).
+    Hooking of the higher root onto a lower one (any: the lowest node of a component is never
+    hooked, so it ends as its root), then pointer jumping to the roots: each pass at least
+    halves the number of components that still have a link, so O(log n) passes of numpy work
+    (no Python loop per node or pair).
     """
     parent = np.arange(n, dtype=np.int64)
     while a.size:
@@ -69,7 +70,7 @@ def _labels(n: int, a: IntArray, b: IntArray) -> IntArray:
         if not moving.any():
             break
         a, b, pa, pb = a[moving], b[moving], pa[moving], pb[moving]
-        np.minimum.at(parent, np.maximum(pa, pb), np.minimum(pa, pb))
+        parent[np.maximum(pa, pb)] = np.minimum(pa, pb)
         while True:
             grand = parent[parent]
             if np.array_equal(grand, parent):
