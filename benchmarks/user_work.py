@@ -149,7 +149,7 @@ def startup(repeat: int, folder: Path) -> None:
         warnings.simplefilter("ignore")
         import geobrep
         geobrep.read(sys.argv[1])
-        heavy = ("geobrep.plugins.blocks", "pyproj", "geobrep.plugins.clip", "scipy",
+        heavy = ("geobrep.plugins.blocks._builder", "geobrep.plugins.clip._", "scipy", "pyproj",
                  "geobrep.model.entities.nurbs", "geobrep.model.entities.octree")
         print(json.dumps([h for h in heavy if any(m.startswith(h) for m in sys.modules)]))
         """,
