@@ -1,9 +1,11 @@
-"""Rectilinear block grids (OMF volumes, geoh5 block models) as point sets of their cell centres.
+"""Rectilinear block grids (OMF volumes, geoh5 block models): cell sizes along each axis.
 
-geobrep has no grid entity yet: a grid reads as a :class:`~geobrep.model.entities.PointSet`
-whose points are the cell centres, with the cell values as point properties and the grid itself
-(origin, axes, cell sizes along each axis) in ``metadata["grid"]``, cells ordered with u
-fastest, then v, then w. A writer that finds such a point set writes the grid back, exactly.
+A grid whose cells along each axis have one size is a :class:`~geobrep.model.entities.RegularGrid`;
+one with varying sizes, which RegularGrid cannot hold, reads as a
+:class:`~geobrep.model.entities.PointSet` whose points are the cell centres, with the cell values
+as point properties and the grid itself (origin, axes, cell sizes along each axis) in
+``metadata["grid"]``. Cells are ordered u fastest, then v, then w. Writers take either and
+write the grid back.
 
 >>> import numpy as np
 >>> grid = Grid(origin=(0.0, 0.0, 0.0), sizes=(np.ones(2), np.ones(1), np.full(1, 2.0)))
@@ -21,9 +23,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.model.entities import PointSet
+from geobrep.model.entities import Entity, PointSet, RegularGrid
+from geobrep.model.properties import PropertyMap
 
-__all__ = ["GRID_KEY", "Grid", "triple"]
+__all__ = ["GRID_KEY", "Grid", "as_grid", "cell_values", "grid_entity", "triple"]
 
 GRID_KEY = "grid"
 """The metadata key of a point set that stands for a grid."""
@@ -97,3 +100,39 @@ class Grid:
         except (KeyError, TypeError, ValueError):
             return None
         return grid if grid.n_cells == entity.n_points and len(grid.axes) == 3 else None
+
+
+def as_grid(entity: Any) -> Grid | None:
+    """The grid of a :class:`~geobrep.model.entities.RegularGrid` (axes as unit vectors, exact
+    for axis-aligned grids) or of a point set standing for one; None for anything else."""
+    if entity.type == "RegularGrid":
+        axes = np.asarray(entity.axes, dtype=np.float64)
+        steps = np.sqrt((axes * axes).sum(axis=1))  # sqrt(x * x) == |x|: exact when aligned
+        u, v, w = (np.full(n, s) for n, s in zip(entity.counts, steps, strict=True))
+        unit = tuple(triple(a / s) for a, s in zip(axes, steps, strict=True))
+        return Grid(origin=triple(entity.origin), sizes=(u, v, w), axes=unit)
+    return Grid.of(entity)
+
+
+def cell_values(entity: Any) -> PropertyMap:
+    """The cell properties of a grid entity (a stand-in point set holds them per point)."""
+    found: PropertyMap = entity.cell_data if entity.type == "RegularGrid" else entity.point_data
+    return found
+
+
+def grid_entity(grid: Grid, name: str, cells: PropertyMap, metadata: dict[str, Any]) -> Entity:
+    """A :class:`RegularGrid` when the cells along each axis have one size, else the point
+    set of the cell centres standing for ``grid``."""
+    if all(len(s) and bool(np.all(s == s[0])) for s in grid.sizes):
+        u, v, w = (np.asarray(a) * s[0] for a, s in zip(grid.axes, grid.sizes, strict=True))
+        return RegularGrid(
+            origin=grid.origin,
+            u=u,
+            v=v,
+            w=w,
+            counts=grid.shape,
+            cell_data=cells,
+            name=name,
+            metadata=metadata,
+        )
+    return grid.point_set(name, point_data=cells, metadata=metadata)

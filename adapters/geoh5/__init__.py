@@ -2,8 +2,9 @@
 
 Written from the published geoh5 schema, not through geoh5py (which pins ``numpy<1.27``):
 Points, Curve, Surface and BlockModel objects with their vertex and cell data, both ways,
-float64 coordinates exactly. A block model reads as a point set of its cell centres standing
-for the grid (``metadata["grid"]``, as OMF volumes), which writes back as the same block model.
+float64 coordinates exactly. A block model reads as a ``RegularGrid`` (or, when its cell sizes
+vary, as a point set of its cell centres standing for the grid, ``metadata["grid"]``) and writes
+back as the same block model.
 ``make geoh5-check`` cross-checks the files with geoh5py in an environment of its own. Needs
 h5py (the ``geoh5`` extra).
 
@@ -26,13 +27,14 @@ from geobrep.adapters._file_format import file_format
 from geobrep.errors import FormatError, MissingDependencyError
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry, NoOptions
+from geobrep.model.entities import RegularGrid
 from geobrep.model.scene import Scene
 
 __all__ = ["CAPABILITIES", "geobrep_register_formats"]
 
 #: What a geoh5 workspace written by geobrep holds.
 CAPABILITIES = FormatCapabilities(
-    entity_types=frozenset({"PointSet", "PolyLine", "Surface"}),
+    entity_types=frozenset({"PointSet", "PolyLine", "Surface", "RegularGrid"}),
     point_data=True,
     cell_data=True,
     names=True,
@@ -75,8 +77,13 @@ def _losses(scene: Scene, path: Path) -> list[str]:
     patched = [s.label for s in scene.surfaces if s.patch_labels is not None]
     if patched:
         lost.append(f"patch labels of {len(patched)} surfaces dropped")
+    for grid in scene.of_type(RegularGrid):
+        if grid.point_data:
+            lost.append(f"{grid.label}: point properties dropped (block models hold cell data)")
     for entity in scene.entities:
         for field in ("point_data", "cell_data"):
+            if entity.type == "RegularGrid" and field == "point_data":
+                continue
             for name, prop in getattr(entity, field).items():
                 where = f"{entity.label} {name!r}"
                 values = prop.values

@@ -19,7 +19,7 @@ import h5py
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.adapters._grid_cells import Grid, triple
+from geobrep.adapters._grid_cells import Grid, as_grid, cell_values, grid_entity, triple
 from geobrep.adapters.cell_layout import chain_segments
 from geobrep.adapters.limits import check_declared
 from geobrep.errors import FormatError, GeobrepError
@@ -126,7 +126,7 @@ def _rotation(grid: Grid) -> float:
 
 
 def _write_object(root: h5py.Group, entity: Entity) -> None:
-    grid = Grid.of(entity)
+    grid = as_grid(entity)
     kind = (
         "Block model"
         if grid
@@ -151,7 +151,7 @@ def _write_object(root: h5py.Group, entity: Entity) -> None:
         order = _geoh5_order(grid.shape)
         values = {
             n: {"values": np.asarray(p.values)[order], "description": p.description}
-            for n, p in entity.point_data.items()
+            for n, p in cell_values(entity).items()
         }
         _write_data(root, obj, PropertyMap(values), "Cell")
         return
@@ -243,7 +243,7 @@ def _block_model(obj: h5py.Group, name: str) -> Entity:
     corner = corner + start @ np.asarray(axes) if start.any() else corner
     grid = Grid(origin=triple(corner), sizes=tuple(np.diff(d) for d in delimiters), axes=axes)  # type: ignore[arg-type]
     order = np.argsort(_geoh5_order(grid.shape))
-    return grid.point_set(name, point_data=_read_data(obj, "Cell", grid.n_cells, order))
+    return grid_entity(grid, name, _read_data(obj, "Cell", grid.n_cells, order), {})
 
 
 def _object(obj: h5py.Group) -> Entity | None:

@@ -2,8 +2,9 @@
 
 Surfaces, line sets, point sets and volumes with their data arrays (scalars, 2- and 3-vectors
 on vertices, faces, segments or cells) and colours, both ways; float64 coordinates exactly.
-A volume reads as a point set of its cell centres standing for the grid (``metadata["grid"]``),
-which writes back as the same volume. Needs the ``omf`` extra (``pip install geobrep[omf]``).
+A volume reads as a ``RegularGrid`` (or, when its cell sizes vary, as a point set of its cell
+centres standing for the grid, ``metadata["grid"]``) and writes back as the same volume.
+Needs the ``omf`` extra (``pip install geobrep[omf]``).
 
 >>> import geobrep, tempfile, pathlib
 >>> scene = geobrep.datasets.faulted_layer_cake()
@@ -33,7 +34,7 @@ __all__ = ["CAPABILITIES", "geobrep_register_formats"]
 
 #: What an OMF v1 project holds.
 CAPABILITIES = FormatCapabilities(
-    entity_types=frozenset({"PointSet", "PolyLine", "Surface"}),
+    entity_types=frozenset({"PointSet", "PolyLine", "Surface", "RegularGrid"}),
     point_data=True,
     cell_data=True,
     names=True,

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.adapters._grid_cells import Grid, triple
+from geobrep.adapters._grid_cells import Grid, as_grid, cell_values, grid_entity, triple
 from geobrep.adapters.cell_layout import chain_segments
 from geobrep.adapters.limits import check_declared, inflate_bounded, read_budget
 from geobrep.errors import FormatError, GeobrepError
@@ -70,7 +70,7 @@ def _element(entity: Entity) -> Any:
         "description": str(entity.metadata.get("description", "")),
         "color": _color(entity),
     }
-    grid = Grid.of(entity)
+    grid = as_grid(entity)
     if grid is not None:
         geometry = omf.VolumeGridGeometry(
             origin=list(grid.origin),
@@ -81,9 +81,10 @@ def _element(entity: Entity) -> Any:
             axis_v=list(grid.axes[1]),
             axis_w=list(grid.axes[2]),
         )
-        return omf.VolumeElement(
-            geometry=geometry, data=_data(entity.point_data, "cells"), **common
-        )
+        data = _data(cell_values(entity), "cells")
+        if entity.type == "RegularGrid":
+            data += _data(entity.point_data, "vertices")
+        return omf.VolumeElement(geometry=geometry, data=data, **common)
     if isinstance(entity, Surface):
         geometry = omf.SurfaceGeometry(vertices=_c(entity.vertices), triangles=_c(entity.faces))
         data = _data(entity.point_data, "vertices") + _data(entity.cell_data, "faces")
@@ -214,9 +215,9 @@ def _entity(element: Any, project_origin: NDArray[np.float64]) -> Entity | None:
             ),  # type: ignore[arg-type]
             axes=tuple(triple(a) for a in (geometry.axis_u, geometry.axis_v, geometry.axis_w)),
         )
-        return grid.point_set(
-            element.name, point_data=_properties(element, "cells"), metadata=common["metadata"]
-        )
+        found = grid_entity(grid, element.name, _properties(element, "cells"), common["metadata"])
+        nodes = _properties(element, "vertices")
+        return found.replace(point_data=nodes) if nodes and found.type == "RegularGrid" else found
     return None  # grid surfaces: skipped (reported)
 
 

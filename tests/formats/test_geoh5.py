@@ -163,3 +163,43 @@ def test_damaged_files_are_format_errors(tmp_path: Path) -> None:
     with pytest.raises(FormatError) as caught:
         read(path)
     assert caught.value.path == path
+
+
+@pytest.mark.parametrize("name", ["geoh5", "omf"])
+def test_regular_grids_come_back_exactly(name: str, tmp_path: Path) -> None:
+    pytest.importorskip("omf") if name == "omf" else None
+    grid = geobrep.RegularGrid(
+        origin=[450000.0, 6700000.0, -900.0],
+        u=[25.0, 0, 0],
+        v=[0, 50.0, 0],
+        w=[0, 0, 12.5],
+        counts=(4, 3, 2),
+        cell_data={"grade": np.linspace(0.0, 1.0, 24)},
+        name="grade model",
+    )
+    (back,) = read(write(Scene(entities=[grid]), tmp_path / f"g.{name}")).entities
+    assert isinstance(back, geobrep.RegularGrid)
+    for field in ("origin", "u", "v", "w"):
+        assert getattr(back, field).tobytes() == getattr(grid, field).tobytes(), field
+    assert back.counts == grid.counts
+    assert back.cell_data["grade"].values.tobytes() == grid.cell_data["grade"].values.tobytes()
+
+
+def test_a_block_model_rotated_in_plan_keeps_its_rotation(tmp_path: Path) -> None:
+    angle = np.radians(30.0)
+    c, s = np.cos(angle), np.sin(angle)
+    grid = geobrep.RegularGrid(
+        origin=[0.0, 0, 0],
+        u=[10 * c, 10 * s, 0],
+        v=[-5 * s, 5 * c, 0],
+        w=[0, 0, 2.0],
+        counts=(2, 2, 1),
+        name="rotated",
+    )
+    path = write(Scene(entities=[grid]), tmp_path / "r.geoh5")
+    with h5py.File(path, "r") as store:
+        (obj,) = store["GEOSCIENCE/Objects"].values()
+        assert obj.attrs["Rotation"] == pytest.approx(30.0)
+    (back,) = read(path).entities
+    assert isinstance(back, geobrep.RegularGrid)
+    np.testing.assert_allclose(back.axes, grid.axes, rtol=0, atol=1e-12)
