@@ -2,9 +2,15 @@
 
 from __future__ import annotations
 
-import runpy
+import os
 import sys
-from pathlib import Path
+
+# benchmarks/inspect.py is named after the stdlib module: keep this folder off sys.path so that
+# `import inspect` (numpy, pydantic) finds the standard one.
+sys.path[:] = [p for p in sys.path if os.path.abspath(p or ".") != os.path.dirname(__file__)]
+
+import runpy  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 HERE = Path(__file__).parent
 
