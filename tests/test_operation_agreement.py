@@ -29,11 +29,16 @@ FUNCTIONS = {
     "build_blocks": (geobrep.build_blocks, {}),
     "build": (geobrep.build_blocks, {}),
     "voxelize": (geobrep.voxelize, {}),
+    "check": (geobrep.inspect, {}),
+    "repair": (geobrep.repair, {}),
 }
 #: Keys that say what a step does with the scene, not how the function works.
-STEP_ONLY = {"fit": {"points", "keep_input", "check", "max_triangles"}}
+STEP_ONLY = {
+    "fit": {"points", "keep_input", "check", "max_triangles"},
+    "check": {"on_defects"},  # what the step does with defects: fail, warn or continue
+}
 #: Commands whose parser is derived from the declaration (the rest are listed in the report).
-DERIVED = {"reproject", "clip", "section", "voxelize"}
+DERIVED = {"reproject", "clip", "section", "voxelize", "check", "repair"}
 
 
 def test_every_operation_has_a_function() -> None:
