@@ -17,8 +17,11 @@ from geobrep.model.entities import (
     NurbsSurface,
     Polygon,
     PolyLine,
+    RegularGrid,
+    StructuredGrid,
     Surface,
     TetMesh,
+    Well,
 )
 from geobrep.model.properties import PropertyMap
 from geobrep.model.scene import Scene
@@ -75,7 +78,29 @@ def _counts(entity: Entity) -> dict[str, int]:
         counts["leaves"] = entity.n_leaves
     elif isinstance(entity, Block):
         counts["sides"] = len(entity.sides)
+    else:
+        counts.update(_grid_counts(entity))
     return counts
+
+
+def _grid_counts(entity: Entity) -> dict[str, int]:
+    """Cells, points and well contents of the grid and well entities."""
+    if isinstance(entity, RegularGrid | StructuredGrid):
+        ni, nj, nk = entity.counts
+        counts = {"ni": ni, "nj": nj, "nk": nk, "cells": entity.n_cells}
+        if isinstance(entity, RegularGrid):
+            counts["points"] = entity.n_points
+        else:
+            counts["active_cells"] = entity.n_active
+        return counts
+    if isinstance(entity, Well):
+        return {
+            "segments": entity.n_cells,
+            "markers": len(entity.markers),
+            "zones": len(entity.zones),
+            "logs": len(entity.logs),
+        }
+    return {}
 
 
 def describe_entity(entity: Entity) -> dict[str, Any]:

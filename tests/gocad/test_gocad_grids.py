@@ -211,3 +211,54 @@ def _native(entity: Well, folder: Path) -> Path:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return geobrep.write(entity, folder / "w.geobrep")
+
+
+class TestOctreeVoxet:
+    def test_a_voxelized_model_survives_a_voxet(self, tmp_path: Path) -> None:
+        octree = geobrep.voxelize(geobrep.datasets.faulted_layer_cake(), depth=5)
+        grid = RegularGrid.from_octree(octree)
+        assert grid.counts == (32, 32, 32)
+        labels = np.asarray(grid.cell_data["label"].values)
+        # every finest cell of a leaf carries the leaf's label: volumes per label agree
+        cell = grid.cell_volume
+        for label, volume in octree.label_volumes().items():
+            assert np.count_nonzero(labels == label) * cell == pytest.approx(volume, rel=1e-12)
+        back = geobrep.read(geobrep.write(grid, tmp_path / "cake.vo")).entities[0]
+        assert isinstance(back, RegularGrid)
+        assert back.n_points == 32**3  # one node per voxel, at its centre
+        again = back.to_octree()
+        np.testing.assert_array_equal(again.codes, octree.codes)  # merged back into its leaves
+        np.testing.assert_array_equal(again.levels, octree.levels)
+        np.testing.assert_array_equal(again.labels, octree.labels)
+        np.testing.assert_array_equal(again.origin, octree.origin)
+        assert again.size == octree.size
+        assert again.label_volumes() == octree.label_volumes()
+
+    def test_only_full_same_label_families_merge(self) -> None:
+        tree = geobrep.LinearOctree(
+            codes=[0, 8, 9, 16, 24],
+            levels=[1, 2, 2, 1, 1],
+            depth=2,
+            origin=[10, 20, 30],
+            size=4.0,
+            labels=[7, 9, 9, 3, 3],
+        )
+        grid = RegularGrid.from_octree(tree)
+        assert np.bincount(np.asarray(grid.cell_data["label"].values) + 1).tolist() == [
+            38,
+            0,
+            0,
+            0,
+            16,
+            0,
+            0,
+            0,
+            8,
+            0,
+            2,
+        ]
+        assert grid.to_octree() == tree.replace(name="")
+
+    def test_a_rotated_grid_is_refused(self) -> None:
+        with pytest.raises(geobrep.EntityValidationError, match="axis-aligned"):
+            rotated_voxet().to_octree("facies")

@@ -11,7 +11,7 @@ of cells along each axis. Cell ``(i, j, k)`` is element ``i + ni·(j + nj·k)`` 
 from __future__ import annotations
 
 from functools import cached_property
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -20,6 +20,9 @@ from pydantic import Field
 from geobrep.geometry.bbox import BoundingBox
 from geobrep.model.arrays import Vector3
 from geobrep.model.entities.base import Entity
+
+if TYPE_CHECKING:
+    from geobrep.model.entities.octree import LinearOctree
 
 __all__ = ["RegularGrid", "lattice"]
 
@@ -107,6 +110,29 @@ class RegularGrid(Entity):
         cells = np.where((local == counts) & (counts > 0), counts - 1, cells)
         inside = ((cells >= 0) & (cells < counts)).all(axis=1)
         return np.where(inside, self.cell_index(np.clip(cells, 0, counts - 1)), -1)
+
+    @classmethod
+    def from_octree(cls, octree: LinearOctree, name: str = "label") -> RegularGrid:
+        """The grid of ``octree``'s finest cells, its leaf labels (1 without labels) as the
+        int64 cell property ``name``, -1 (no-data) outside the leaves.
+
+        >>> from geobrep import LinearOctree
+        >>> tree = LinearOctree(codes=[0], levels=[1], depth=1, origin=[0, 0, 0], size=2.0)
+        >>> RegularGrid.from_octree(tree).cell_data["label"].values.tolist()
+        [1, -1, -1, -1, -1, -1, -1, -1]
+        """
+        from geobrep.model.entities._grid_octree import grid_from_octree
+
+        return grid_from_octree(octree, name)
+
+    def to_octree(self, name: str = "label") -> LinearOctree:
+        """The linear octree of the cells whose property ``name`` is set (not -1 or no-data),
+        eight same-label siblings merged into their parent. Cell data are the cells; point data
+        (a Voxet's nodes) are voxels centred on the points. The grid must be axis-aligned with
+        cubic cells."""
+        from geobrep.model.entities._grid_octree import octree_from_grid
+
+        return octree_from_grid(self, name)
 
     @cached_property
     def bounds(self) -> BoundingBox | None:
