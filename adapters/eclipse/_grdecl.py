@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.adapters.limits import check_declared, human_bytes
+from geobrep.adapters.limits import check_declared, human_bytes, parse_numbers
 from geobrep.errors import EntityValidationError, FormatError
 from geobrep.host.capabilities import SKIPPED_ON_READ
 from geobrep.model.entities import StructuredGrid
@@ -50,7 +50,7 @@ def _numbers(block: bytes, path: Path, keyword: str, line: int) -> NDArray[np.fl
     """The values of one keyword, ``n*v`` repeats expanded."""
     if b"*" not in block:
         try:
-            return np.array(block.split(), dtype=np.float64) if block.strip() else np.zeros(0)
+            return parse_numbers(block)
         except ValueError as exc:
             raise FormatError(f"{keyword}: a value is not a number ({exc})", path, line) from None
     out: list[NDArray[np.float64]] = []
@@ -166,12 +166,13 @@ def read_grdecl(path: Path) -> Scene:
     return Scene(entities=[grid], name=path.stem, metadata=metadata)
 
 
-def _values_text(values: NDArray[Any]) -> str:
+def _values_text(values: NDArray[Any], per_line: int = 8) -> str:
+    """Values ``per_line`` to a line, then ``/`` alone on its line (as OpenGeode reads it)."""
     if values.dtype.kind in "iub":
         texts = values.astype(np.int64).astype(str).tolist()
     else:
         texts = list(map(repr, values.astype(np.float64).tolist()))
-    rows = [" ".join(texts[i : i + 8]) for i in range(0, len(texts), 8)]
+    rows = [" ".join(texts[i : i + per_line]) for i in range(0, len(texts), per_line)]
     return "\n".join(rows) + "\n/\n"
 
 
@@ -182,8 +183,13 @@ def grdecl_text(grid: StructuredGrid) -> str:
     ni, nj, nk = grid.counts
     coord = np.array(grid.coord)
     coord[:, [2, 5]] *= -1.0
-    parts = [f"-- {grid.name or 'grid'} written by geobrep\n", f"SPECGRID\n{ni} {nj} {nk} 1 F /\n"]
-    parts += ["COORD\n", _values_text(coord.ravel()), "ZCORN\n", _values_text(-grid.zcorn)]
+    parts = [f"-- {grid.name or 'grid'} written by geobrep\n", f"SPECGRID\n{ni} {nj} {nk} 1 F\n/\n"]
+    parts += [
+        "COORD\n",
+        _values_text(coord.ravel(), per_line=6),
+        "ZCORN\n",
+        _values_text(-grid.zcorn),
+    ]
     if grid.actnum is not None:
         parts += ["ACTNUM\n", _values_text(grid.actnum.astype(np.int8))]
     for name, prop in grid.cell_data.items():

@@ -47,7 +47,7 @@ def _write(scene: Scene, path: Path, options: object) -> None:
     assert isinstance(options, GocadOptions)
     grid_type = grid_object_for(path, options.object_type)
     if grid_type is not None:
-        write_grid_object(scene, path, grid_type)
+        write_grid_object(scene, path, grid_type, options.voxet_ascii)
         return
     write_gocad(scene, path, options)
 

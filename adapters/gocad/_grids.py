@@ -54,7 +54,7 @@ def grid_object_for(path: Path, object_type: str | None) -> str | None:
     return None if object_type else _BY_SUFFIX.get(path.suffix.lower())
 
 
-def write_grid_object(scene: Scene, path: Path, object_type: str) -> None:
+def write_grid_object(scene: Scene, path: Path, object_type: str, ascii_data: bool = False) -> None:
     """Write the scene's one entity of the object type's entity class."""
     _, wanted = GRID_OBJECTS[object_type]
     chosen = [e for e in scene.entities if isinstance(e, wanted)]
@@ -66,7 +66,7 @@ def write_grid_object(scene: Scene, path: Path, object_type: str) -> None:
         report(f"a {object_type} file holds one {wanted.__name__}; not written: {shown}")
     entity = chosen[0]
     if isinstance(entity, RegularGrid):
-        write_voxet(entity, scene.crs, path)
+        write_voxet(entity, scene.crs, path, ascii_data)
     else:
         assert isinstance(entity, Well)
         path.write_text(well_text(entity, scene.crs), encoding="utf-8")

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.gocad._keyed import KeyedFile, KeyedLine, parse_keyed, read_text
-from geobrep.adapters.limits import check_declared
+from geobrep.adapters.limits import check_declared, parse_numbers
 from geobrep.errors import EntityValidationError, FormatError
 from geobrep.model.entities import RegularGrid
 from geobrep.model.properties import Property
@@ -203,7 +203,7 @@ def _ascii_table(
     text = read_text(side, "ASCII data file")
     body = re.sub(r"(?m)^\s*[*#].*$", "", text)
     try:
-        numbers = np.array(body.split(), dtype=np.float64)
+        numbers = parse_numbers(body)
     except ValueError as exc:
         raise FormatError(f"ASCII data file: {exc}", side) from None
     columns = 3 + len(props)

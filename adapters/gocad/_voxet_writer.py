@@ -72,9 +72,10 @@ def _dtype_words(values: NDArray[Any], name: str) -> tuple[np.dtype[Any], list[s
 
 
 def voxet_text(
-    grid: RegularGrid, crs: CRS | None, files: dict[str, str]
+    grid: RegularGrid, crs: CRS | None, files: dict[str, str], ascii_file: str | None = None
 ) -> tuple[str, dict[str, NDArray[Any]]]:
-    """The header text and the big-endian arrays to write under ``files[name]``."""
+    """The header text and the big-endian arrays to write under ``files[name]`` (or, with
+    ``ascii_file``, the arrays of its table)."""
     props, first, counts = _layout(grid)
     flip = np.array([1.0, 1.0, z_sign_of(crs)])
     lines = ["GOCAD Voxet 1", "HEADER {", f"name:{quote_rest(grid.name or 'voxet')}", "}"]
@@ -89,6 +90,8 @@ def voxet_text(
         "AXIS_N " + " ".join(str(n) for n in counts),
         "AXIS_TYPE even even even",
     ]
+    if ascii_file is not None:
+        lines.append(f"ASCII_DATA_FILE {ascii_file}")
     arrays: dict[str, NDArray[Any]] = {}
     for number, (name, prop) in enumerate(props.items(), start=1):
         values = np.asarray(prop.values)
@@ -102,6 +105,9 @@ def voxet_text(
             lines.append(f"PROP_UNIT {number} {prop.unit}")
         if prop.no_data_value is not None:
             lines.append(f"PROP_NO_DATA_VALUE {number} {format_float(prop.no_data_value)}")
+        if ascii_file is not None:
+            arrays[name] = values
+            continue
         for key, value in zip(words[::2], words[1::2], strict=True):
             lines.append(f"{key} {number} {value}")
         lines.append(f"PROP_FORMAT {number} RAW")
@@ -112,10 +118,33 @@ def voxet_text(
     return "\n".join(lines) + "\n", arrays
 
 
-def write_voxet(grid: RegularGrid, crs: CRS | None, path: Path) -> None:
-    """Write the header to ``path`` and the property files beside its final name."""
+def _ascii_table(arrays: dict[str, NDArray[Any]], counts: tuple[int, ...]) -> str:
+    """``I J K value...`` rows (i fastest) under a three-line ``*`` header, as GOCAD writes."""
+    ni, nj, nk = counts
+    k, j, i = np.meshgrid(np.arange(nk), np.arange(nj), np.arange(ni), indexing="ij")
+    columns = [c.ravel().astype(str) for c in (i, j, k)]
+    for values in arrays.values():
+        as_text = values.astype(np.int64) if values.dtype.kind in "iub" else values
+        columns.append(np.array(list(map(repr, as_text.tolist()))))
+    rows = [" ".join(row) for row in zip(*columns, strict=True)]
+    header = "*\n*  I  J  K  " + "  ".join(arrays) + "\n*\n"
+    return header + "\n".join(rows) + "\n"
+
+
+def write_voxet(grid: RegularGrid, crs: CRS | None, path: Path, ascii_data: bool = False) -> None:
+    """Write the header to ``path`` and the property files (or the ASCII table) beside its
+    final name."""
     final = final_name(path)
-    props, _, _ = _layout(grid)
+    props, _, counts = _layout(grid)
+    if ascii_data:
+        if any(not re.fullmatch(r"\S+", name) for name in props):
+            raise FormatError(f"{grid.label}: an ASCII_DATA_FILE column name has no blanks")
+        table = f"{final.stem}__ascii@@"
+        text, arrays = voxet_text(grid, crs, {}, table)
+        with atomic_write(final.with_name(table)) as temporary:
+            temporary.write_text(_ascii_table(arrays, counts), encoding="utf-8")
+        path.write_text(text, encoding="utf-8")
+        return
     files = {name: f"{final.stem}__{_SAFE.sub('_', name)}@@" for name in props}
     if len(set(files.values())) != len(files):
         files = {name: f"{final.stem}__{i}@@" for i, name in enumerate(props, start=1)}

@@ -32,6 +32,11 @@ class GocadOptions(BaseModel):
     ``HeterogeneousGroup``, ``Voxet`` or ``Well``; default: from the extension
     (.ts .pl .vs .so .ml .gp .vo .wl)."""
 
+    voxet_ascii: bool = False
+    """Writing a Voxet: its properties in one ``ASCII_DATA_FILE`` table of ``I J K value...``
+    rows (as test.vo; the form OpenGeode-GeosciencesIO reads) instead of raw big-endian
+    ``PROP_FILE``s. Values are written as exact decimal text and read back as float64."""
+
     def merge_tolerance_for(self, diagonal: float) -> float:
         """The joining distance for a model whose bounding-box diagonal is ``diagonal``."""
         if self.merge_tolerance is not None:

@@ -118,6 +118,16 @@ class TestVoxet:
         with pytest.raises(FormatError, match="not a file beside the header"):
             geobrep.read(out)
 
+    def test_ascii_data_file_round_trip(self, tmp_path: Path) -> None:
+        grid = rotated_voxet()
+        out = geobrep.write(grid, tmp_path / "a.vo", voxet_ascii=True)
+        assert "ASCII_DATA_FILE a__ascii@@" in out.read_text()
+        back = geobrep.read(out).entities[0]
+        assert isinstance(back, RegularGrid)
+        for name, prop in grid.point_data.items():  # exact values, read back as float64
+            np.testing.assert_array_equal(back.point_data[name].values, prop.values)
+            assert back.point_data[name].no_data_value == prop.no_data_value
+
     def test_cell_data_is_written_at_the_cell_centres(self, tmp_path: Path) -> None:
         grid = rotated_voxet()
         cells = grid.replace(point_data={}, cell_data={"k": np.arange(60, dtype=np.float64)})
