@@ -164,11 +164,10 @@ def _add_mesh(
     """One node, mesh and material for ``geometry`` (``source`` is the entity it shows)."""
     world = np.asarray(geometry.vertices, np.float64)  # type: ignore[attr-defined]
     local = frame.to_local(world)
-    single = to_y_up(local).astype(np.float32)
+    y_up = to_y_up(local)
+    single = y_up.astype(np.float32)
     if len(local):
-        out.rounding = max(
-            out.rounding, float(np.abs(single.astype(np.float64) - to_y_up(local)).max())
-        )
+        out.rounding = max(out.rounding, float(np.abs(single - y_up).max()))
         out.low = np.minimum(out.low, local.min(axis=0))
         out.high = np.maximum(out.high, local.max(axis=0))
     row = len(out.rows)
