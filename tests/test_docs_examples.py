@@ -8,6 +8,8 @@ from pathlib import Path
 
 import pytest
 
+import geobrep.plugins
+
 ROOT = Path(__file__).resolve().parent.parent
 PAGES = sorted([ROOT / "README.md", *(ROOT / "docs").rglob("*.md")])
 BLOCK = re.compile(r"^```python\n(.*?)^```", re.MULTILINE | re.DOTALL)
@@ -28,6 +30,7 @@ def test_page_examples_run(page: Path, tmp_path: Path) -> None:
             exec(code, namespace)
     finally:
         os.chdir(cwd)
+        geobrep.plugins.reload()  # pages register plugins: the next test sees installed ones only
 
 
 def test_pages_have_examples() -> None:
