@@ -241,6 +241,10 @@ class SectionStep(_CutStep):
     """The plane a·x + b·y + c·z + d = 0."""
 
 
+def _one_name(text: str) -> tuple[str]:
+    return (text,)
+
+
 class FitStep(StepOptions):
     """Fit a surface to each PointSet (or to the entities named in ``points``) with the
     fitter ``method``; ``options`` are the fitter's (e.g. ``epsilon``). The scene becomes the
@@ -252,12 +256,26 @@ class FitStep(StepOptions):
     kind: ClassVar[str] = "fit"
 
     method: str = "hybrid"
-    points: tuple[str, ...] | None = Field(default=None, min_length=1)
-    options: Options = Field(default_factory=dict)
-    keep_input: bool = False
-    check_epsilon: bool = Field(default=False, alias="check")
-    max_triangles: int = Field(default=1_000_000, ge=2)
-    """Bound on the mesh a write step makes of each fitted NURBS surface."""
+    """fitter: skinning, approximation, kriging, hybrid, ... (default hybrid)"""
+    points: Annotated[
+        tuple[str, ...] | None, Cli(flags=("--entity",), parse=_one_name, metavar="NAME")
+    ] = Field(default=None, min_length=1)
+    """names of the PointSets (or PolyLines) to fit (default: every PointSet); on the command
+    line, the one to fit when the file holds several"""
+    options: Annotated[
+        Options,
+        Cli(
+            flags=("--option",), append=True, parse=key_value, collect=as_dict, metavar="KEY=VALUE"
+        ),
+    ] = Field(default_factory=dict)
+    """a fitter option (VALUE is JSON when it parses, else text); repeatable"""
+    keep_input: Annotated[bool, Cli(hidden=True)] = False
+    """keep the points and the rest of the scene beside the surfaces"""
+    check_epsilon: Annotated[bool, Cli(flags=("--check",))] = Field(default=False, alias="check")
+    """fail when what was written does not meet ε (the command: exit status 3)"""
+    max_triangles: Annotated[int, Cli(metavar="N")] = Field(default=1_000_000, ge=2)
+    """bound on the mesh written of each fitted NURBS surface when the format cannot hold NURBS
+    (default 1000000)"""
 
     model_config = ConfigDict(populate_by_name=True)
 

@@ -12,62 +12,42 @@ report then gives the accuracy of both, and ``--check`` judges the mesh, the obj
 
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
+from pydantic import BaseModel, ConfigDict
+
+from geobrep.batch.pipeline import FitStep
 from geobrep.cli.common import format_name
 from geobrep.errors import FileAccessError, FormatError, OptionsError
+from geobrep.host.operations import Cli
 from geobrep.model.entities import Entity, PointSet, PolyLine
-from geobrep.ops.fitting import MAX_TRIANGLES
 
-__all__ = ["add_parser", "run"]
+__all__ = ["COMMAND", "DESCRIPTION", "EXIT_NOT_MET", "OPERATION", "FitCommand", "run"]
 
+OPERATION = "fit"
+DESCRIPTION = "Fit a surface to points and report σ, max |d| and n per subset against ε."
 EXIT_NOT_MET = 3
 
 
-def add_parser(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "fit",
-        help="fit a surface to points (skinning, approximation, kriging, hybrid)",
-        description="Fit a surface to points and report σ, max |d| and n per subset against ε.",
-    )
-    parser.add_argument("points", help="points: CSV (x,y,z[,...]) or any format holding a PointSet")
-    parser.add_argument("out", help="output file; its extension chooses the format")
-    parser.add_argument(
-        "--method", default="hybrid", help="fitter: skinning, approximation, kriging, hybrid, ..."
-    )
-    parser.add_argument("--epsilon", type=float, help="control error ε for the accuracy report")
-    parser.add_argument(
-        "--option",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="a fitter option (VALUE is JSON when it parses, else text); repeatable",
-    )
-    parser.add_argument(
-        "--format",
-        type=format_name("read"),
-        help="input format name, when the extension is not enough",
-    )
-    parser.add_argument("--entity", help="name of the PointSet to fit, when the file holds several")
-    parser.add_argument("--report", help="also write the report as JSON to this file")
-    parser.add_argument("--json", action="store_true", help="print the report as JSON")
-    parser.add_argument(
-        "--check",
-        action="store_true",
-        help=f"exit with status {EXIT_NOT_MET} when what was written does not meet ε",
-    )
-    parser.add_argument(
-        "--max-triangles",
-        type=int,
-        default=MAX_TRIANGLES,
-        metavar="N",
-        help="bound on the mesh written when OUT's format cannot hold NURBS "
-        f"(default {MAX_TRIANGLES})",
-    )
-    parser.set_defaults(run=run)
+class FitCommand(BaseModel):
+    """The files and command-line-only options of ``geobrep fit``."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+    points_file: Annotated[str, Cli(positional=True, metavar="points")]
+    """points: CSV (x,y,z[,...]) or any format holding a PointSet"""
+    out: Annotated[str, Cli(positional=True)]
+    """output file; its extension chooses the format"""
+    epsilon: float | None = None
+    """control error ε for the accuracy report (the fitter option epsilon)"""
+    format: Annotated[str | None, Cli(parse=format_name("read"))] = None
+    """input format name, when the extension is not enough"""
+    report: str | None = None
+    """also write the report as JSON to this file"""
+    as_json: Annotated[bool, Cli(flags=("--json",))] = False
+    """print the report as JSON"""
 
 
 def _load_points(path: Path, fmt: str | None, entity: str | None) -> PointSet | PolyLine:
@@ -90,43 +70,32 @@ def _load_points(path: Path, fmt: str | None, entity: str | None) -> PointSet | 
     return chosen
 
 
-def _options(pairs: list[str]) -> dict[str, Any]:
-    options: dict[str, Any] = {}
-    for pair in pairs:
-        key, sep, value = pair.partition("=")
-        if not sep or not key.strip():
-            raise OptionsError(f"--option {pair!r}: expected KEY=VALUE")
-        try:
-            options[key.strip()] = json.loads(value)
-        except json.JSONDecodeError:
-            options[key.strip()] = value
-    return options
-
-
-def run(args: argparse.Namespace) -> int:
+def run(step: FitStep, args: FitCommand) -> int:
     from geobrep.ops.fitting import fit
     from geobrep.ops.io import atomic_write
 
-    points = _load_points(Path(args.points), args.format, args.entity)
-    options = _options(args.option)
+    entity = step.points[0] if step.points else None
+    points = _load_points(Path(args.points_file), args.format, entity)
+    options: dict[str, Any] = dict(step.options)
     if args.epsilon is not None:
         options["epsilon"] = args.epsilon
-    if args.max_triangles < 2:
-        raise OptionsError(f"--max-triangles must be at least 2, got {args.max_triangles}")
-    result = fit(points, method=args.method, **options)
+    result = fit(points, method=step.method, **options)
     out = Path(args.out)
-    result = result.write(out, max_triangles=args.max_triangles)
+    result = result.write(out, max_triangles=step.max_triangles)
     report = result.report
     if report is not None and args.report:
         with atomic_write(args.report) as tmp:
             tmp.write_text(report.model_dump_json(indent=2), encoding="utf-8")
-    if args.json:
+    if args.as_json:
         payload = report.model_dump(mode="json") if report is not None else None
         print(json.dumps({"output": str(out), "report": payload}, indent=2))
     else:
-        print(f"{args.method} fit of {points.n_points} points -> {out}")
+        print(f"{step.method} fit of {points.n_points} points -> {out}")
         if report is not None:
             print(report.to_text())
-    if args.check and report is not None and report.written_passed is False:
+    if step.check_epsilon and report is not None and report.written_passed is False:
         return EXIT_NOT_MET
     return 0
+
+
+COMMAND = FitCommand

@@ -202,7 +202,9 @@ class TestCommandLine:
         assert "no such file" in capsys.readouterr().err
         good = tmp_path / "good.csv"
         good.write_text("0 0 0\n1 0 0\n0 1 0\n1 1 1\n")
-        assert main(["fit", str(good), str(tmp_path / "o.geobrep"), "--option", "oops"]) == 1
+        assert (
+            main(["fit", str(good), str(tmp_path / "o.geobrep"), "--option", "oops"]) == 2
+        )  # malformed: usage
         assert "expected KEY=VALUE" in capsys.readouterr().err
         assert not (tmp_path / "o.geobrep").exists()
 
