@@ -38,7 +38,7 @@ STEP_ONLY = {
     "check": {"on_defects"},  # what the step does with defects: fail, warn or continue
 }
 #: Commands whose parser is derived from the declaration (the rest are listed in the report).
-DERIVED = {"reproject", "clip", "section", "voxelize", "check", "repair"}
+DERIVED = {"reproject", "clip", "section", "voxelize", "fit", "build_blocks", "check", "repair"}
 
 
 def test_every_operation_has_a_function() -> None:

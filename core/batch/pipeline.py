@@ -290,7 +290,15 @@ class BuildBlocksStep(StepOptions):
     kind: ClassVar[str] = "build_blocks"
 
     builder: str = "blocks"
-    options: Options = Field(default_factory=dict)
+    """the registered builder (default blocks)"""
+    options: Annotated[
+        Options,
+        Cli(
+            flags=("--option",), append=True, parse=key_value, collect=as_dict, metavar="KEY=VALUE"
+        ),
+    ] = Field(default_factory=dict)
+    """a builder option (VALUE is JSON when it parses, else text; the blocks builder's options
+    are flags of their own); repeatable"""
 
     def check(self, registries: Registries) -> None:
         _get(registries.builders, self.builder, "builder").validate_options(self.options)

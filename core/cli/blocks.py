@@ -7,72 +7,82 @@ format its extension names (or ``--format``).
 
 from __future__ import annotations
 
-import argparse
 import json
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
-from geobrep.cli.common import add_allow_empty, format_name, read_input
+from pydantic import BaseModel, ConfigDict
+
+from geobrep.batch.pipeline import BuildBlocksStep
+from geobrep.cli.common import format_name, read_input
 from geobrep.errors import OptionsError
+from geobrep.host.operations import Cli, as_dict
 from geobrep.model.entities import Block, Entity
 from geobrep.model.scene import Group, Scene
 from geobrep.ops.io import write
 
-__all__ = ["add_parser", "describe", "merge_scenes", "run"]
+__all__ = [
+    "COMMAND",
+    "DESCRIPTION",
+    "OPERATION",
+    "OPTIONS_FOR",
+    "BlocksCommand",
+    "describe",
+    "extra_options",
+    "merge_scenes",
+    "run",
+]
+
+OPERATION = "build_blocks"
+DESCRIPTION = (
+    "Build closed, oriented blocks, their patches, arcs and corners from the surfaces of "
+    "one or more files (merged into one model), and write the result."
+)
 
 
-def add_parser(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "blocks",
-        help="build blocks from conformal surfaces",
-        description=(
-            "Build closed, oriented blocks, their patches, arcs and corners from the surfaces of "
-            "one or more files (merged into one model), and write the result."
-        ),
-    )
-    parser.add_argument("inputs", nargs="+", metavar="IN", help="input files (e.g. several .ts)")
-    parser.add_argument("output", metavar="OUT", help="output file (e.g. .geobrep or .ml)")
-    parser.add_argument(
-        "--format",
-        type=format_name("write"),
-        help="output format name, when the extension is not enough",
-    )
-    parser.add_argument(
-        "--input-format", type=format_name("read"), help="input format name for every input file"
-    )
-    parser.add_argument(
-        "--tolerance",
-        type=float,
-        help="vertex merge and contact distance (model units; default: 4 quanta of the "
-        "precision the coordinates carry, e.g. float32 or 2 decimals)",
-    )
-    parser.add_argument(
-        "--relative-tolerance",
-        type=float,
-        help="vertex merge and contact distance relative to the model diagonal",
-    )
-    parser.add_argument(
-        "--free-borders",
-        choices=("internal", "remove", "error"),
-        help="patches with a free border: internal surfaces (default), removed (the paper's "
-        "rule) or an error",
-    )
-    parser.add_argument("--gap-tolerance", type=float, help="gap detection distance (model units)")
-    parser.add_argument(
-        "--no-conformity-check",
-        action="store_true",
-        help="skip the search for crossing surfaces, T-junctions and gaps",
-    )
-    parser.add_argument(
-        "--no-validate", action="store_true", help="skip the closed/oriented check of each block"
-    )
-    parser.add_argument(
-        "--surfaces", help="comma-separated names of the surfaces to build from (default: all)"
-    )
-    parser.add_argument("--report", metavar="FILE", help="also write the report as JSON here")
-    parser.add_argument("--json", action="store_true", help="print the report as JSON")
-    add_allow_empty(parser)
-    parser.set_defaults(run=run)
+class BlocksCommand(BaseModel):
+    """The files and command-line-only options of ``geobrep blocks``."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+    inputs: Annotated[list[str], Cli(positional=True, nargs="+", metavar="IN")]
+    """input files (e.g. several .ts)"""
+    output: Annotated[str, Cli(positional=True, metavar="OUT")]
+    """output file (e.g. .geobrep or .ml)"""
+    format: Annotated[str | None, Cli(parse=format_name("write"))] = None
+    """output format name, when the extension is not enough"""
+    input_format: Annotated[str | None, Cli(parse=format_name("read"))] = None
+    """input format name for every input file"""
+    report: Annotated[str | None, Cli(metavar="FILE")] = None
+    """also write the report as JSON here"""
+    as_json: Annotated[bool, Cli(flags=("--json",))] = False
+    """print the report as JSON"""
+    allow_empty: bool = False
+    """accept a result with nothing in it (otherwise: a warning and exit 4)"""
+
+
+def extra_options() -> type[BaseModel] | None:
+    """The options of the ``blocks`` builder: each is a flag (``--tolerance``, ...)."""
+    from geobrep.host import registries
+
+    builders = registries().builders
+    return builders.get("blocks").options if "blocks" in builders else None
+
+
+def options_for(command: BlocksCommand, values: Mapping[str, Any]) -> BuildBlocksStep:
+    """The ``build_blocks`` step the arguments give: the builder's flags become its options."""
+    model = extra_options()
+    options: dict[str, Any] = as_dict(values.get("options") or [])
+    if model is not None:
+        for name, info in model.model_fields.items():
+            if name in values:
+                options[info.alias or name] = values[name]
+    data = {"builder": values.get("builder", "blocks"), "options": options}
+    return BuildBlocksStep.model_validate(data)
+
+
+OPTIONS_FOR = options_for
 
 
 def merge_scenes(scenes: list[Scene], sources: list[str]) -> Scene:
@@ -118,35 +128,20 @@ def merge_scenes(scenes: list[Scene], sources: list[str]) -> Scene:
     return Scene(entities=entities, groups=groups, crs=crs, name=name)
 
 
-def _options(args: argparse.Namespace) -> dict[str, Any]:
-    options: dict[str, Any] = {}
-    for field in ("tolerance", "relative_tolerance", "free_borders", "gap_tolerance"):
-        value = getattr(args, field)
-        if value is not None:
-            options[field] = value
-    if args.no_conformity_check:
-        options["check_conformity"] = False
-    if args.no_validate:
-        options["validate"] = False
-    if args.surfaces:
-        options["surfaces"] = tuple(s.strip() for s in args.surfaces.split(",") if s.strip())
-    return options
-
-
-def run(args: argparse.Namespace) -> int:
+def run(step: BuildBlocksStep, args: BlocksCommand) -> int:
     from geobrep.ops.building import build_blocks
     from geobrep.ops.io import atomic_write
 
     sources = [str(path) for path in args.inputs]
     scenes = [read_input(args, path, format=args.input_format) for path in sources]
     scene = merge_scenes(scenes, sources)
-    built = build_blocks(scene, **_options(args))
+    built = build_blocks(scene, step.builder, **step.options)
     target = write(built, args.output, format=args.format)
     report = built.metadata.get("block_report")
     if args.report:
         with atomic_write(Path(args.report)) as temporary:
             temporary.write_text(json.dumps(report, indent=2))
-    if args.json:
+    if args.as_json:
         print(json.dumps({"output": str(target), "report": report}, indent=2))
     else:
         print(describe(built, report if isinstance(report, dict) else {}))
@@ -178,3 +173,6 @@ def describe(built: Scene, report: dict[str, Any]) -> str:
         unit = f" ({block.unit_name})" if block.unit_name else ""
         lines.append(f"  #{block.id} {block.name}{unit}: volume {size}")
     return "\n".join(lines)
+
+
+COMMAND = BlocksCommand

@@ -81,6 +81,7 @@ def _add_commands(subparsers: Any) -> None:
             command=getattr(module, "COMMAND", SceneCommand),
             description=getattr(module, "DESCRIPTION", None),
             options_for=getattr(module, "OPTIONS_FOR", None),
+            extra=module.extra_options() if hasattr(module, "extra_options") else None,
         )
     for spec in registry:
         name = spec.command_name

@@ -55,8 +55,10 @@ def add_operation_parser(
     command: type[BaseModel] = SceneCommand,
     description: str | None = None,
     options_for: OptionsFor | None = None,
+    extra: type[BaseModel] | None = None,
 ) -> argparse.ArgumentParser:
-    """The subcommand of ``spec``: its arguments from ``command`` and ``spec.options``."""
+    """The subcommand of ``spec``: its arguments from ``command`` and ``spec.options`` (and
+    ``extra``, the options model of the plugin item the operation runs by default)."""
     parser: argparse.ArgumentParser = subparsers.add_parser(
         spec.command_name,
         help=spec.summary,
@@ -64,6 +66,8 @@ def add_operation_parser(
     )
     add_arguments(parser, command)
     add_arguments(parser, spec.options, skip=command.model_fields)
+    if extra is not None:  # the options of the plugin item the operation runs (a builder's)
+        add_arguments(parser, extra, skip=[*command.model_fields, *spec.options.model_fields])
 
     def call(args: argparse.Namespace) -> int:
         given = options_from_args(command, args)

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
+
+from geobrep.plugins import Cli
 
 __all__ = ["BlockBuilderOptions", "FreeBorders"]
 
@@ -35,12 +37,49 @@ class BlockBuilderOptions(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True, populate_by_name=True)
 
-    tolerance: float | None = Field(default=None, ge=0.0)
-    relative_tolerance: float | None = Field(default=None, ge=0.0, lt=1e-2)
-    free_borders: FreeBorders = "internal"
-    check_conformity: bool = True
-    gap_tolerance: float | None = Field(default=None, ge=0.0)
-    relative_gap_tolerance: float = Field(default=1e-3, ge=0.0, lt=0.5)
-    angle_tolerance: float = Field(default=1e-10, ge=0.0, lt=0.1)
-    validate_blocks: bool = Field(default=True, alias="validate")
-    surfaces: tuple[int | str, ...] | None = None
+    tolerance: Annotated[
+        float | None,
+        Cli(
+            help="vertex merge and contact distance (model units; default: 4 quanta of the "
+            "precision the coordinates carry, e.g. float32 or 2 decimals)"
+        ),
+    ] = Field(default=None, ge=0.0)
+    relative_tolerance: Annotated[
+        float | None,
+        Cli(help="vertex merge and contact distance relative to the model diagonal"),
+    ] = Field(default=None, ge=0.0, lt=1e-2)
+    free_borders: Annotated[
+        FreeBorders,
+        Cli(
+            help="patches with a free border: internal surfaces (default), removed (the paper's "
+            "rule) or an error"
+        ),
+    ] = "internal"
+    check_conformity: Annotated[
+        bool,
+        Cli(
+            negate="--no-conformity-check",
+            help="skip the search for crossing surfaces, T-junctions and gaps",
+        ),
+    ] = True
+    gap_tolerance: Annotated[float | None, Cli(help="gap detection distance (model units)")] = (
+        Field(default=None, ge=0.0)
+    )
+    relative_gap_tolerance: Annotated[
+        float, Cli(help="gap detection distance relative to the model diagonal (default 1e-3)")
+    ] = Field(default=1e-3, ge=0.0, lt=0.5)
+    angle_tolerance: Annotated[
+        float,
+        Cli(help="radians under which two patches around an arc overlap (default 1e-10)"),
+    ] = Field(default=1e-10, ge=0.0, lt=0.1)
+    validate_blocks: Annotated[
+        bool, Cli(negate="--no-validate", help="skip the closed/oriented check of each block")
+    ] = Field(default=True, alias="validate")
+    surfaces: Annotated[
+        tuple[int | str, ...] | None,
+        Cli(
+            parse=lambda text: tuple(s.strip() for s in text.split(",") if s.strip()),
+            metavar="SURFACES",
+            help="comma-separated names of the surfaces to build from (default: all)",
+        ),
+    ] = None
