@@ -10,7 +10,7 @@ STAMPS := $(VENV)/.geobrep-stamps
 EXAMPLE_PLUGIN := docs/examples/geobrep-example-plugin
 PIP_QUIET := --quiet --disable-pip-version-check
 
-.PHONY: demo test test-newest test-min lint typecheck pytest bench fuzz schemas sysdeps clean help geoh5-check
+.PHONY: demo test test-newest test-min lint typecheck pytest bench fuzz schemas docs-tables sysdeps clean help geoh5-check
 
 help:
 	@echo "make demo   - run the demo on the built-in sample model (writes demo-output/)"
@@ -136,6 +136,9 @@ geoh5-check: $(STAMPS)/test $(GEOH5_VENV)/.geoh5py
 
 schemas: $(STAMPS)/base
 	$(PY) -m geobrep.schemas
+
+docs-tables: $(STAMPS)/base
+	$(PY) -m geobrep.batch.operations docs/pipelines.md
 
 bench: $(STAMPS)/test
 	$(PY) -m pip install $(PIP_QUIET) -e ".[bench]"

@@ -11,7 +11,7 @@ import pytest
 
 import geobrep
 import geobrep.schemas
-from geobrep.batch.operations import builtin_operations
+from geobrep.batch.operations import builtin_operations, docs_tables, update_docs
 from geobrep.batch.pipeline import option_names
 from geobrep.cli.main import build_parser
 from geobrep.host.operations import cli_flags
@@ -88,3 +88,24 @@ def test_docs_name_every_option(name: str) -> None:
         named |= set(re.findall(r"`(\w+)`", block.group(0)))
     missing = [key for key in option_names(SPECS[name].options) if key not in named]
     assert not missing, f"docs/pipelines.md, step {name!r}, does not describe {missing}"
+
+
+def test_docs_tables_are_current() -> None:
+    page = DOCS / "pipelines.md"
+    text = page.read_text(encoding="utf-8")
+    assert update_docs(text) == text, "docs/pipelines.md option tables are stale: make docs-tables"
+    for kind in docs_tables():
+        assert f"<!-- options: {kind} -->" in text, f"docs/pipelines.md lacks the table of {kind}"
+
+
+@pytest.mark.parametrize("name", sorted(SPECS))
+def test_docs_table_rows_are_the_options_and_flags(name: str) -> None:
+    spec = SPECS[name]
+    rows = [line for line in docs_tables()[name].splitlines()[2:]]
+    keys = [re.match(r"\| `([^`]+)` \|", row).group(1) for row in rows]  # type: ignore[union-attr]
+    assert keys == option_names(spec.options)
+    for row, (field, info) in zip(rows, spec.options.model_fields.items(), strict=True):
+        flags = cli_flags(field, info) if spec.command_name else ()
+        for flag in flags:
+            assert f"`{flag}`" in row
+        assert row.split("|")[4].strip(), f"{name}: option {field!r} has no description"

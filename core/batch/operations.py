@@ -12,6 +12,9 @@ is every operation: these first, then the ones plugins registered
 
 from __future__ import annotations
 
+import re
+import sys
+from pathlib import Path
 from typing import Any
 
 from geobrep.batch.pipeline import (
@@ -27,11 +30,11 @@ from geobrep.batch.pipeline import (
     VoxelizeStep,
 )
 from geobrep.errors import EntityNotFoundError
-from geobrep.host.operations import OperationRegistry, OperationSpec
+from geobrep.host.operations import OperationRegistry, OperationSpec, options_table
 from geobrep.model.entities import Entity, PointSet, PolyLine
 from geobrep.model.scene import Scene
 
-__all__ = ["builtin_operations", "operations"]
+__all__ = ["builtin_operations", "docs_tables", "operations", "update_docs"]
 
 
 def _scene(result: Any, scene: Scene) -> Scene:
@@ -227,3 +230,34 @@ def operations() -> OperationRegistry:
         if not taken:  # a plugin cannot replace a built-in operation
             registry.add(spec)
     return registry
+
+
+_TABLE = re.compile(r"(<!-- options: (\w+) -->\n).*?(<!-- end options -->)", re.S)
+
+
+def docs_tables() -> dict[str, str]:
+    """The option table of every built-in operation's step, by step kind (generated)."""
+    return {
+        str(spec.step_kind): options_table(spec.options, spec.command_name)
+        for spec in builtin_operations()
+    }
+
+
+def update_docs(text: str) -> str:
+    """``text`` with each ``<!-- options: KIND -->`` ... ``<!-- end options -->`` section
+    holding the generated table of that step (``make docs-tables`` rewrites the pages)."""
+    tables = docs_tables()
+
+    def table(match: re.Match[str]) -> str:
+        kind = match.group(2)
+        if kind not in tables:
+            raise KeyError(f"no operation has the step kind {kind!r}")
+        return f"{match.group(1)}{tables[kind]}\n{match.group(3)}"
+
+    return _TABLE.sub(table, text)
+
+
+if __name__ == "__main__":  # pragma: no cover - `make docs-tables`
+    for name in sys.argv[1:]:
+        page = Path(name)
+        page.write_text(update_docs(page.read_text(encoding="utf-8")), encoding="utf-8")

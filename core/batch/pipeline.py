@@ -214,7 +214,9 @@ class ClipBoxStep(_CutStep):
     kind: ClassVar[str] = "clip_box"
 
     bounds: Bounds6 | None = None
+    """The box [xmin, xmax, ymin, ymax, zmin, zmax] whose inside is kept."""
     planes: tuple[Plane4, ...] | None = Field(default=None, min_length=1)
+    """Or convex planes [a, b, c, d] whose negative sides all hold the inside."""
 
     @model_validator(mode="after")
     def _one_region(self) -> ClipBoxStep:
@@ -310,6 +312,7 @@ class BuildStep(BuildBlocksStep):
     kind: ClassVar[str] = "build"
 
     builder: str
+    """the registered builder (a plugin's)"""
 
 
 class VoxelizeStep(StepOptions):

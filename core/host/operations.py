@@ -358,24 +358,27 @@ def _default_text(info: FieldInfo) -> str:
 
 
 def options_table(
-    model: type[BaseModel], skip: Iterable[str] = (), surface: Literal["step", "cli"] = "step"
+    model: type[BaseModel], command: str | None = None, skip: Iterable[str] = ()
 ) -> str:
-    """The Markdown table of an options model: key (pipeline) or flag (command line), default,
-    what it does. Fields named in ``skip`` are left out."""
-    rows = [
-        "| Option | Flag | Default | What |" if surface == "step" else "| Flag | Default | What |",
-        "|---|---|---|---|" if surface == "step" else "|---|---|---|",
-    ]
+    """The Markdown table of an options model: each key (as a pipeline writes it), its flag on
+    ``geobrep COMMAND`` (when the operation has a command), its default and what it does.
+
+    >>> from pydantic import Field
+    >>> class Every(BaseModel):
+    ...     every: int = Field(default=2, description="keep every N-th point")
+    >>> print(options_table(Every, "thin"))
+    | Key | `geobrep thin` | Default | What |
+    |---|---|---|---|
+    | `every` | `--every` | `2` | keep every N-th point |
+    """
+    flag_heading = f"`geobrep {command}`" if command else "Flag"
+    rows = [f"| Key | {flag_heading} | Default | What |", "|---|---|---|---|"]
     left_out = set(skip)
     for name, info in model.model_fields.items():
         if name in left_out:
             continue
-        flags = ", ".join(f"`{f}`" for f in cli_flags(name, info)) or "—"
-        what = " ".join((cli_of(info).help or info.description or "").split())
+        flags = ", ".join(f"`{f}`" for f in cli_flags(name, info)) if command else ""
+        what = " ".join((info.description or cli_of(info).help or "").split())
         what = what.replace("|", "\\|")
-        key = info.alias or name
-        if surface == "step":
-            rows.append(f"| `{key}` | {flags} | {_default_text(info)} | {what} |")
-        elif flags != "—":
-            rows.append(f"| {flags} | {_default_text(info)} | {what} |")
+        rows.append(f"| `{info.alias or name}` | {flags or '—'} | {_default_text(info)} | {what} |")
     return "\n".join(rows)
