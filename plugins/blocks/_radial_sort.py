@@ -27,7 +27,7 @@ from geobrep.plugins.blocks._csr import concatenated_ranges
 from geobrep.plugins.blocks._orientation import DirectionTriangles, direction_triangles
 from geobrep.plugins.blocks._patches import PatchSplit
 
-__all__ = ["SortedArcs", "radial_angles", "sort_arcs"]
+__all__ = ["SortedArcs", "half_plane_angles", "radial_angles", "sort_arcs"]
 
 
 #: Relative length under which a third vertex counts as lying on the arc's line.
@@ -52,8 +52,25 @@ def radial_angles(
     The zero direction is fixed per edge direction, so angles of one group compare directly.
     """
     third = triangles[rows.triangle].sum(axis=1) - rows.start - rows.end
-    origin = vertices[rows.start]
-    axis = vertices[rows.end] - origin
+    return half_plane_angles(vertices, rows.start, rows.end, third)
+
+
+def half_plane_angles(
+    vertices: FloatArray, start: IntArray, end: IntArray, third: IntArray
+) -> tuple[FloatArray, BoolArray]:
+    """Angle in (−π, π] of the half-plane of vertex ``third[i]`` about edge ``start[i] →
+    end[i]`` (right-hand rule, thumb along the edge), and which thirds lie on the edge's line.
+
+    The zero direction depends only on the edge's direction, so rows on one edge compare.
+
+    >>> import numpy as np
+    >>> points = np.array([[0, 0, 0], [0, 0, 1], [1, 0, 0], [0, 1, 0], [-1, 0, 0.5]], float)
+    >>> angles, flat = half_plane_angles(points, np.zeros(3, int), np.ones(3, int), np.arange(2, 5))
+    >>> [round(float(a), 4) for a in np.unwrap(angles - angles[0])], flat.tolist()
+    ([0.0, 1.5708, 3.1416], [False, False, False])
+    """
+    origin = vertices[start]
+    axis = vertices[end] - origin
     leg = vertices[third] - origin
     axis /= np.linalg.norm(axis, axis=1)[:, None]
     helper = np.zeros_like(axis)

@@ -5,7 +5,8 @@ follows the data's precision by default, :mod:`geobrep.plugins.blocks.precision`
 where they cross, touch (T-junctions) or stop short of each other (gaps), with the surfaces,
 faces and vertices involved. The kernels are exported too: :func:`overlapping_pairs` (the grid
 broad phase over triangles of different groups), :func:`triangles_intersect` (exact-enough
-triangle-triangle tests within a tolerance) and :func:`point_triangle_distance`.
+triangle-triangle tests within a tolerance), :func:`point_triangle_distance` and
+:func:`half_plane_angles` (the radial sort's angles of triangles about an arc edge).
 
 >>> import geobrep
 >>> found = surface_nonconformities(geobrep.datasets.faulted_layer_cake().surfaces)
@@ -29,11 +30,13 @@ from geobrep.plugins.blocks._conformity import (
     triangles_intersect,
 )
 from geobrep.plugins.blocks._patches import split_patches
+from geobrep.plugins.blocks._radial_sort import half_plane_angles
 from geobrep.plugins.blocks._soup import Soup, build_soup
 
 __all__ = [
     "Contact",
     "Nonconformities",
+    "half_plane_angles",
     "overlapping_pairs",
     "point_triangle_distance",
     "surface_nonconformities",

@@ -70,6 +70,14 @@ BUILTIN_CHECKS: tuple[tuple[str, str, str, str, str | None, str | None], ...] = 
     ("gaps", "conformity", "_conformal", "Gaps along contacts", "GapOptions", None),
     ("patch_boundaries", "brep", "_brep", "Patches bounded by arcs", None, None),
     ("arc_ends", "brep", "_brep", "Arcs between corners", None, None),
+    (
+        "arc_patch_order",
+        "brep",
+        "_radial",
+        "Patches around each arc in right-hand order",
+        None,
+        None,
+    ),
     ("patch_sides", "brep", "_brep", "A block on each side of each patch", None, None),
     ("block_closure", "brep", "_brep", "Blocks closed", None, None),
     (
