@@ -221,7 +221,9 @@ print(json.dumps(sorted(sys.modules)))
 NOT_FOR_A_TSURF = (
     "scipy",
     "pyproj",
-    "geobrep.plugins.blocks._builder",
+    "geobrep.plugins.blocks._",
+    "geobrep.plugins.blocks.conformity",
+    "geobrep.plugins.checks._",
     "geobrep.plugins.clip._",
     "geobrep.plugins.fit._",
     "geobrep.plugins.voxelize._",

@@ -9,7 +9,9 @@ see ``docs/inspection.md``.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import importlib
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from geobrep.plugins import hookimpl
 
@@ -101,23 +103,30 @@ BUILTIN_CHECKS: tuple[tuple[str, str, str, str, str | None, str | None], ...] = 
 )
 
 
+def _on_first_use(module: str, name: str) -> Callable[..., Any]:
+    """``module.name``, imported when the check first runs (discovery stays cheap)."""
+
+    def run(scene: Any, options: Any, context: Any) -> Any:
+        code = importlib.import_module(f"geobrep.plugins.checks.{module}")
+        return getattr(code, name)(scene, options, context)
+
+    run.__name__ = run.__qualname__ = name
+    return run
+
+
 @hookimpl
 def geobrep_register_checks(registry: CheckRegistry) -> None:
-    import importlib
-
     from geobrep.plugins import CheckSpec, NoOptions
     from geobrep.plugins.checks import options as option_models
 
     for name, family, module, title, options, repairs in BUILTIN_CHECKS:
-        code = importlib.import_module(f"geobrep.plugins.checks.{module}")
-        function = getattr(code, name)
         registry.add(
             CheckSpec(
                 name=name,
-                description=(function.__doc__ or title).split("\n\n")[0].replace("\n", " "),
+                description=title,
                 title=title,
                 family=family,
-                function=function,
+                function=_on_first_use(module, name),
                 options=getattr(option_models, options) if options else NoOptions,
                 repairs=repairs,
             )
