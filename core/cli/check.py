@@ -4,7 +4,9 @@ Each file is read as it holds the model (no on-read repairs) and inspected
 (:func:`geobrep.inspect`); the exit code is 0 when every file is clean and 3 when defects were
 found (as ``fit --check`` does), 1 on an error, 2 on a usage error. ``--defects`` writes the
 defects of every file as entities (points, edges, triangles, coloured by check) to a file of
-any writable format (``.vtp``, ``.gpkg``, ``.geobrep``, ...). The options are those of the
+any writable format (``.vtp``, ``.gpkg``, ``.geobrep``, ...). Progress (a line per file and
+per check) goes to stderr on a terminal or once the work is long, so ``--json`` output on
+stdout stays clean (:class:`~geobrep.cli.common.ProgressLines`). The options are those of the
 ``check`` operation (:class:`~geobrep.batch.pipeline.CheckStep`).
 """
 
@@ -12,13 +14,14 @@ from __future__ import annotations
 
 import json
 import sys
+import time
 from pathlib import Path
 from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.batch.pipeline import CheckStep
-from geobrep.cli.common import format_name, read_input
+from geobrep.cli.common import ProgressLines, format_name, progress_mode, read_input
 from geobrep.host.operations import Cli
 
 __all__ = ["COMMAND", "DESCRIPTION", "EXIT_DEFECTS", "OPERATION", "CheckCommand", "run"]
@@ -46,6 +49,11 @@ class CheckCommand(BaseModel):
     """print the reports as JSON (a list, one per file)"""
     defects: Annotated[str | None, Cli(metavar="OUT")] = None
     """write the defects as entities to OUT (.vtp, .gpkg, .geobrep, ...)"""
+    progress: Annotated[bool, Cli(flags=("--progress",))] = False
+    """a progress line per file and check on stderr even when the work is short and stderr
+    is no terminal"""
+    no_progress: Annotated[bool, Cli(flags=("--no-progress",))] = False
+    """no progress lines (default: on a terminal, or once the work has run 2 s)"""
 
 
 COMMAND = CheckCommand
@@ -69,9 +77,16 @@ def run(options: CheckStep, args: CheckCommand) -> int:
     reports: list[dict[str, Any]] = []
     layers = []
     found = 0
-    for path in args.files:
+    lines = ProgressLines("check", progress_mode(args.progress, args.no_progress))
+    for number, path in enumerate(args.files, start=1):
+        begin = time.perf_counter()
         scene = read_input(args, path, format=args.format, repair=False)
-        report = inspect(scene, options.checks, options.tolerance)
+        lines.line(
+            f"file {number}/{len(args.files)} {path} read {time.perf_counter() - begin:.2f} s"
+        )
+        report = inspect(
+            scene, options.checks, options.tolerance, progress=lines.step(path, "check")
+        )
         found += report.n_defects
         if args.as_json:
             reports.append({"file": path, **report.model_dump(mode="json")})

@@ -18,7 +18,7 @@ from __future__ import annotations
 import difflib
 import math
 import time
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -38,6 +38,7 @@ __all__ = [
     "CheckSection",
     "Defect",
     "InspectionReport",
+    "Progress",
     "check_names",
     "inspect",
 ]
@@ -46,6 +47,9 @@ Element = Literal[
     "vertex", "edge", "triangle", "face", "tet", "segment", "patch", "arc", "corner", "block"
 ]
 Point = tuple[float, float, float]
+
+Progress = Callable[[str, int, int, float], None]
+"""``progress(step, done, total, seconds)``: called after each check (or repair action)."""
 
 #: Defects listed per section by default (the count is always complete).
 MAX_LISTED = 1000
@@ -341,6 +345,7 @@ def inspect(
     *,
     options: Mapping[str, Mapping[str, Any]] | None = None,
     max_listed: int = MAX_LISTED,
+    progress: Progress | None = None,
 ) -> InspectionReport:
     """Run ``checks`` (names, ``"all"``, or ``None`` for the default checks) on a scene.
 
@@ -348,7 +353,8 @@ def inspect(
     vertices, T-junctions, gaps —; by default it follows the data's own precision (the
     builder's rule, see docs/inspection.md). ``options`` maps a check name to its options
     (validated by the check's options model). Each section lists up to ``max_listed`` defects;
-    its ``count`` is always the full number.
+    its ``count`` is always the full number. ``progress(check, done, total, seconds)`` is
+    called after each check (the command line's progress lines).
 
     Errors: :class:`~geobrep.errors.OptionsError` for an unknown check, a bad tolerance or
     options, or an empty scene.
@@ -364,10 +370,12 @@ def inspect(
     if max_listed < 0:
         raise OptionsError(f"max_listed: must be ≥ 0, got {max_listed}")
     sections = []
-    for spec in chosen:
+    for done, spec in enumerate(chosen, start=1):
         validated = spec.validate_options(per_check.get(spec.name))
         begin = time.perf_counter()
         defects = _run(spec, scene, validated, context)
+        if progress is not None:
+            progress(spec.name, done, len(chosen), time.perf_counter() - begin)
         sections.append(
             CheckSection(
                 check=spec.name,

@@ -23,6 +23,7 @@ face data follow their faces, a vertex inserted on an edge interpolates its poin
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterable
 from typing import Any
 
@@ -36,7 +37,7 @@ from geobrep.model.entities import Entity, Surface
 from geobrep.model.orientation import orient_blocks, orient_patches
 from geobrep.model.properties import Property
 from geobrep.model.scene import Scene
-from geobrep.ops.inspection import _as_inspected_scene, _checked_tolerance, inspect
+from geobrep.ops.inspection import Progress, _as_inspected_scene, _checked_tolerance, inspect
 
 __all__ = ["ACTIONS", "RepairAction", "RepairReport", "repair"]
 
@@ -313,17 +314,26 @@ def repair(
     scene: Scene | Entity | Iterable[Entity],
     actions: str | Iterable[str] | None = None,
     tolerance: float | None = None,
+    *,
+    progress: Progress | None = None,
 ) -> tuple[Scene, RepairReport]:
     """Mend the defects ``actions`` address (default: all of :data:`ACTIONS`), at ``tolerance``
-    (default: the one :func:`geobrep.inspect` derives from the data's precision)."""
+    (default: the one :func:`geobrep.inspect` derives from the data's precision).
+
+    ``progress(step, done, total, seconds)`` is called after the inspection before, each action
+    and the inspection after (steps ``inspect before``, the action names, ``inspect after``)."""
     source = _as_inspected_scene(scene)
     chosen = _chosen_actions(actions)
     checks = [ADDRESSES[a] for a in chosen]
+    steps, clock = len(chosen) + 2, time.perf_counter()
     before = inspect(source, checks, _checked_tolerance(tolerance), max_listed=0)
+    if progress is not None:
+        progress("inspect before", 1, steps, time.perf_counter() - clock)
     tol = before.tolerance if before.tolerance is not None else 0.0
     done: list[RepairAction] = []
     current = source
-    for action in chosen:
+    for done_steps, action in enumerate(chosen, start=2):
+        clock = time.perf_counter()
         notes: list[str] = []
         per_entity: dict[str, int] = {}
         if action in _PER_SURFACE:
@@ -345,7 +355,12 @@ def repair(
         done.append(
             RepairAction(action=action, count=total, entities=per_entity, notes=tuple(notes))
         )
+        if progress is not None:
+            progress(action, done_steps, steps, time.perf_counter() - clock)
+    clock = time.perf_counter()
     after = inspect(current, checks, tol, max_listed=0)
+    if progress is not None:
+        progress("inspect after", steps, steps, time.perf_counter() - clock)
     report = RepairReport(
         tolerance=tol, actions=tuple(done), before=before.counts(), after=after.counts()
     )

@@ -97,3 +97,52 @@ def test_pipeline_check_and_repair_steps(tmp_path: Path) -> None:
     written = list((tmp_path / "out2").glob("*.geobrep"))
     assert len(written) == 1
     assert geobrep.inspect(geobrep.read(written[0])).ok
+
+
+def _progress(err: str, command: str) -> list[str]:
+    return [line for line in err.splitlines() if line.startswith(f"geobrep {command}: ")]
+
+
+def test_check_progress_goes_to_stderr_and_keeps_json_clean(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    files = (DATA / "modelA1.ml", DATA / "split_cube.ml")
+    code, out, err = run(capsys, "check", *files, "--json", "--progress", "-q")
+    assert code == 3
+    reports = json.loads(out)  # stdout is the JSON alone
+    lines = _progress(err, "check")
+    reads = [line for line in lines if " read " in line]
+    assert reads[0].startswith("geobrep check: file 1/2 ")
+    assert [str(f) in line for f, line in zip(files, reads, strict=True)] == [True, True]
+    for path, report in zip(files, reports, strict=True):
+        checks = [line for line in lines if line.startswith(f"geobrep check: {path} check ")]
+        names = [line.split()[5] for line in checks]
+        assert names == [s["check"] for s in report["sections"]]
+        assert checks[-1].split()[4] == f"{len(names)}/{len(names)}"
+    assert len(lines) == len(reads) + sum(len(r["sections"]) for r in reports)
+
+
+def test_check_progress_only_when_long_or_on_a_terminal(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    code, _, err = run(capsys, "check", DATA / "modelA1.ml", "-q")  # short, stderr no terminal
+    assert code == 0
+    assert _progress(err, "check") == []
+    monkeypatch.setattr("geobrep.cli.common.LONG_WORK_SECONDS", 0.0)  # every run is long
+    code, out, err = run(capsys, "check", DATA / "modelA1.ml", "-q")
+    assert code == 0
+    assert len(_progress(err, "check")) > 10
+    assert "geobrep check:" not in out
+    code, _, err = run(capsys, "check", DATA / "modelA1.ml", "--no-progress", "-q")
+    assert _progress(err, "check") == []
+
+
+def test_repair_progress_lines(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    fixed = tmp_path / "fixed.ml"
+    code, out, err = run(capsys, "repair", DATA / "split_cube.ml", fixed, "--json", "--progress")
+    assert code == 0
+    report = json.loads(out)
+    steps = [line.split()[-3] for line in _progress(err, "repair") if " step " in line]
+    actions = [a["action"] for a in report["actions"]]
+    assert steps == ["before", *actions, "after"]
+    assert _progress(err, "repair")[-1].startswith(f"geobrep repair: {fixed} written ")
