@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import re
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +35,7 @@ from geobrep.host.operations import OperationRegistry, OperationSpec, options_ta
 from geobrep.model.entities import Entity, PointSet, PolyLine
 from geobrep.model.scene import Scene
 
-__all__ = ["builtin_operations", "docs_tables", "operations", "update_docs"]
+__all__ = ["builtin_operations", "docs_tables", "fit_inputs", "operations", "update_docs"]
 
 
 def _scene(result: Any, scene: Scene) -> Scene:
@@ -71,22 +72,27 @@ def _section(scene: Scene, step: SectionStep) -> Scene:
     return _scene(section(scene, step.plane, **_cut(step)), scene)
 
 
+def fit_inputs(scene: Scene, names: Sequence[str] | None) -> list[PointSet | PolyLine]:
+    """What a fit step fits: the PointSets and PolyLines ``names`` names, else every PointSet."""
+    if names is None:
+        points: list[PointSet | PolyLine] = list(scene.point_sets)
+        if not points:
+            raise EntityNotFoundError("the scene holds no PointSet to fit")
+        return points
+    points = []
+    for name in names:
+        found = [e for e in scene.find(name) if isinstance(e, PointSet | PolyLine)]
+        if not found:
+            raise EntityNotFoundError(f"no PointSet or PolyLine named {name!r} to fit")
+        points.extend(found)
+    return points
+
+
 def fit_points(scene: Scene, step: FitStep) -> Scene:
     """The surfaces fitted to the scene's PointSets (or the entities ``step.points`` names)."""
     from geobrep.ops.fitting import fit
 
-    points: list[PointSet | PolyLine]
-    if step.points is None:
-        points = list(scene.point_sets)
-        if not points:
-            raise EntityNotFoundError("the scene holds no PointSet to fit")
-    else:
-        points = []
-        for name in step.points:
-            found = [e for e in scene.find(name) if isinstance(e, PointSet | PolyLine)]
-            if not found:
-                raise EntityNotFoundError(f"no PointSet or PolyLine named {name!r} to fit")
-            points.extend(found)
+    points = fit_inputs(scene, step.points)
     surfaces: list[Entity] = [
         fit(entity, method=step.method, **step.options).surface.model_copy(update={"id": None})
         for entity in points

@@ -51,14 +51,13 @@ from geobrep.batch.pipeline import (
     WriteStep,
 )
 from geobrep.errors import (
-    EntityNotFoundError,
     FileAccessError,
     GeobrepError,
     OptionsError,
     TopologyError,
 )
 from geobrep.host.capabilities import format_losses
-from geobrep.model.entities import Entity, LinearOctree, NurbsSurface, PointSet, PolyLine, Surface
+from geobrep.model.entities import Entity, LinearOctree, NurbsSurface, Surface
 from geobrep.model.scene import Scene
 from geobrep.ops.io import read, write
 
@@ -417,20 +416,10 @@ def _section(step: SectionStep, scene: Scene, work: _Work) -> Applied:
 
 
 def _fit(step: FitStep, scene: Scene, work: _Work) -> Applied:
+    from geobrep.batch.operations import fit_inputs
     from geobrep.ops.fitting import fit
 
-    points: list[PointSet | PolyLine]
-    if step.points is None:
-        points = list(scene.point_sets)
-        if not points:
-            raise EntityNotFoundError("the scene holds no PointSet to fit")
-    else:
-        points = []
-        for name in step.points:
-            found = [e for e in scene.find(name) if isinstance(e, PointSet | PolyLine)]
-            if not found:
-                raise EntityNotFoundError(f"no PointSet or PolyLine named {name!r} to fit")
-            points.extend(found)
+    points = fit_inputs(scene, step.points)
     surfaces: list[Entity] = []
     notes: list[str] = []
     for entity in points:
