@@ -114,7 +114,7 @@ def write_omf(scene: Scene, path: Path) -> None:
         description=str(scene.metadata.get("description", "")),
         elements=[_element(e) for e in scene.entities],
     )
-    try:  # OMFWriter validates the project (once: validating first doubled the time)
+    try:  # geobrep entities are valid already: omf's own validate() would double the time
         omf.OMFWriter(project, str(path))
     except Exception as exc:  # properties' ValidationError names the field
         raise FormatError(f"OMF refuses the project: {exc}", path) from exc
