@@ -79,7 +79,10 @@ def _losses(scene: Scene, path: Path) -> list[str]:
         lost.append(f"patch labels of {len(patched)} surfaces dropped")
     for grid in scene.of_type(RegularGrid):
         if grid.point_data:
-            lost.append(f"{grid.label}: point properties dropped (block models hold cell data)")
+            names = ", ".join(grid.point_data)
+            lost.append(
+                f"{grid.label}: point properties dropped: {names} (block models hold cell data)"
+            )
     for entity in scene.entities:
         for field in ("point_data", "cell_data"):
             if entity.type == "RegularGrid" and field == "point_data":
