@@ -30,7 +30,7 @@ from geobrep.batch.pipeline import (
     SectionStep,
     VoxelizeStep,
 )
-from geobrep.errors import EntityNotFoundError
+from geobrep.errors import EntityNotFoundError, OptionsError
 from geobrep.host.operations import OperationRegistry, OperationSpec, options_table
 from geobrep.model.entities import Entity, PointSet, PolyLine
 from geobrep.model.scene import Scene
@@ -55,6 +55,12 @@ def _reproject(scene: Scene, step: ReprojectStep) -> Scene:
 
 def _clip(scene: Scene, step: ClipStep) -> Scene:
     from geobrep.ops.clipping import clip
+
+    if step.keep == "both":  # two scenes: a pipeline carries both, geobrep.clip returns both
+        raise OptionsError(
+            "keep 'both' gives two scenes: call geobrep.clip(scene, plane, keep='both') or use "
+            "a pipeline (each half goes on through the following steps)"
+        )
 
     return _scene(clip(scene, step.plane, step.keep, **_cut(step)), scene)
 

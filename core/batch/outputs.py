@@ -16,7 +16,7 @@ the file is written (:func:`contained`).
 >>> check_name_pattern("{index.__class__}.vtu")
 Traceback (most recent call last):
 ...
-geobrep.errors.OptionsError: name pattern '{index.__class__}.vtu': {index.__class__} is not a plain field (no attribute access, indexing, conversion or format spec); fields: {stem}, {name}, {ext}, {index}
+geobrep.errors.OptionsError: name pattern '{index.__class__}.vtu': {index.__class__} is not a plain field (no attribute access, indexing, conversion or format spec); fields: {stem}, {name}, {ext}, {index}, {half}
 """  # noqa: E501
 
 from __future__ import annotations
@@ -35,12 +35,16 @@ __all__ = [
     "check_name_pattern",
     "contained",
     "format_name",
+    "half_name",
     "name_fields",
+    "uses_half",
 ]
 
 #: Fields a name pattern may use: the input's name up to its first dot, its file name, the
-#: rest of its file name after the stem (its extensions, with the dot) and its position.
-NAME_FIELDS = ("stem", "name", "ext", "index")
+#: rest of its file name after the stem (its extensions, with the dot), its position, and the
+#: half of a ``clip`` step with ``keep: both`` the scene written is (``negative`` or
+#: ``positive``; ``negative-positive`` after two such steps; empty when no step split it).
+NAME_FIELDS = ("stem", "name", "ext", "index", "half")
 
 _PATTERN_SEPARATORS = ("/", "\\")  # refused in a pattern on every system
 _NAME_SEPARATORS = tuple(s for s in (os.sep, os.altsep, "\0") if s)
@@ -91,10 +95,39 @@ def format_name(pattern: str, fields: Mapping[str, str | int]) -> str:
     return "".join(parts)
 
 
-def name_fields(source: Path, index: int) -> dict[str, str | int]:
+def name_fields(source: Path, index: int, half: str = "") -> dict[str, str | int]:
     """The values of :data:`NAME_FIELDS` for the input ``source`` at position ``index``."""
     stem = source.name.split(".")[0]
-    return {"stem": stem, "name": source.name, "ext": source.name[len(stem) :], "index": index}
+    return {
+        "stem": stem,
+        "name": source.name,
+        "ext": source.name[len(stem) :],
+        "index": index,
+        "half": half,
+    }
+
+
+def uses_half(pattern: str) -> bool:
+    """True when the name pattern substitutes ``{half}``."""
+    return any(field == "half" for _, field, _, _ in string.Formatter().parse(pattern))
+
+
+def half_name(pattern: str, fields: Mapping[str, str | int]) -> str:
+    """The name ``pattern`` gives, told apart by its half as ``geobrep clip --keep both`` does.
+
+    A pattern that does not say ``{half}`` gets ``-HALF`` before its last extension:
+
+    >>> fields = name_fields(Path("cake.ts"), 0, "negative")
+    >>> half_name("{stem}.vtu", fields), half_name("{half}_{stem}.vtu", fields)
+    ('cake-negative.vtu', 'negative_cake.vtu')
+    """
+    name = format_name(pattern, fields)
+    half = str(fields.get("half", ""))
+    if not half or uses_half(pattern):
+        return name
+    suffix = Path(name).suffix
+    stem = name[: len(name) - len(suffix)] if suffix else name
+    return f"{stem}-{half}{suffix}"
 
 
 def check_file_name(name: str) -> None:

@@ -53,7 +53,7 @@ from pydantic import (
 from pydantic.json_schema import SkipJsonSchema
 
 from geobrep.batch.limits import MAX_FILE_BYTES, check_json_depth, load_yaml
-from geobrep.batch.outputs import NAME_FIELDS, check_name_pattern, format_name
+from geobrep.batch.outputs import NAME_FIELDS, check_name_pattern, format_name, uses_half
 from geobrep.errors import FileAccessError, FormatError, GeobrepError, OptionsError
 from geobrep.host.operations import (
     Cli,
@@ -195,7 +195,10 @@ class _CutStep(StepOptions):
 
 class ClipStep(_CutStep):
     """Cut by ``plane`` ``[a, b, c, d]`` and keep one side: ``negative`` (a·x+b·y+c·z+d < 0)
-    or ``positive``. Cut blocks are closed again by caps."""
+    or ``positive``, or ``both``: the two halves go on as two scenes through the following
+    steps, and each write step writes both (named by ``{half}``, or ``NAME-negative.EXT`` and
+    ``NAME-positive.EXT`` as ``geobrep clip --keep both``). Cut blocks are closed again by
+    caps."""
 
     kind: ClassVar[str] = "clip"
 
@@ -203,8 +206,9 @@ class ClipStep(_CutStep):
         Plane4, Cli(group="plane", required=True, parse=comma_numbers(4), metavar="A,B,C,D")
     ]
     """The plane a·x + b·y + c·z + d = 0."""
-    keep: Literal["negative", "positive"] = "negative"
-    """The side kept: negative (a·x+b·y+c·z+d < 0) or positive."""
+    keep: Literal["negative", "positive", "both"] = "negative"
+    """The side kept: negative (a·x+b·y+c·z+d < 0), positive, or both (two scenes from here
+    on; each output named by {half} or NAME-negative.EXT and NAME-positive.EXT)."""
 
 
 class ClipBoxStep(_CutStep):
@@ -386,11 +390,12 @@ class RepairStep(StepOptions):
 class WriteStep(StepOptions):
     """Write the scene as it is at this step (the scene flows on unchanged) to
     ``<output>/<name>``: ``format`` names a registered format, ``name`` a file-name pattern with
-    the bare fields ``{stem}``, ``{name}``, ``{ext}``, ``{index}`` (default ``{stem}`` + the
-    format's extension; no attribute access, indexing or format spec, and the file must lie in
-    the output folder); ``options`` are the format's. NURBS surfaces are tessellated when the format
-    cannot hold them (``tessellate``). Files appear only when the whole pipeline succeeded for
-    that input."""
+    the bare fields ``{stem}``, ``{name}``, ``{ext}``, ``{index}``, ``{half}`` (default
+    ``{stem}`` + the format's extension; no attribute access, indexing or format spec, and the
+    file must lie in the output folder); ``options`` are the format's. NURBS surfaces are
+    tessellated when the format cannot hold them (``tessellate``). After a clip keeping both
+    sides, the step writes each half (see :meth:`Pipeline.halves`). Files appear only when the
+    whole pipeline succeeded for that input."""
 
     kind: ClassVar[str] = "write"
 
@@ -421,9 +426,8 @@ class WriteStep(StepOptions):
         """The registered format this step writes with."""
         if self.format is not None:
             return self.format
-        sample = format_name(
-            self.pattern(registries), {"stem": "x", "name": "x.x", "ext": ".x", "index": 0}
-        )
+        fields = {"stem": "x", "name": "x.x", "ext": ".x", "index": 0, "half": "x"}
+        sample = format_name(self.pattern(registries), fields)
         return registries.formats.choose_writer(Path(sample)).name
 
     def check(self, registries: Registries) -> None:
@@ -730,6 +734,28 @@ class Pipeline(BaseModel):
         data = _parse(text, file)
         return cls.from_data(data, source=str(file)).with_base_dir(file.parent)
 
+    def halves(self) -> list[tuple[str, ...]]:
+        """Per write step, the halves it writes: ``("",)`` for the one scene, or ``("negative",
+        "positive")`` after a clip keeping both (``"negative-positive"``, ... after two).
+
+        >>> Pipeline.from_data({"steps": [{"write": {"format": "vtu"}},
+        ...     {"clip": {"plane": [1, 0, 0, 0], "keep": "both"}}, {"write": {"format": "ply"}}]}
+        ...     ).halves()
+        [('',), ('negative', 'positive')]
+        """
+        halves: tuple[str, ...] = ("",)
+        per_write: list[tuple[str, ...]] = []
+        for step in self.step_list:
+            if isinstance(step, ClipStep) and step.keep == "both":
+                halves = tuple(
+                    f"{half}-{side}" if half else side
+                    for half in halves
+                    for side in ("negative", "positive")
+                )
+            elif isinstance(step, WriteStep):
+                per_write.append(halves)
+        return per_write
+
     # -- plugin resolution ----------------------------------------------------------------------
     def check(self, registries: Registries | None = None) -> Pipeline:
         """Resolve every format, clipper, fitter and builder and validate its options.
@@ -750,6 +776,12 @@ class Pipeline(BaseModel):
             for number, step in enumerate(self.step_list, 1)
             if isinstance(step, WriteStep)
         ]
+        for (number, pattern), halves in zip(writes, self.halves(), strict=True):
+            if uses_half(pattern) and halves == ("",):
+                raise OptionsError(
+                    f"{self._source}: step {number} (write): name pattern {pattern!r} uses "
+                    "{half}, but no clip step before it keeps both sides"
+                )
         seen: dict[str, int] = {}
         for number, pattern in writes:
             if pattern in seen:

@@ -31,7 +31,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.batch.conversion import expand, report_table, run_each, worker_failure
-from geobrep.batch.outputs import OutputFolder, contained, format_name, name_fields
+from geobrep.batch.outputs import OutputFolder, contained, half_name, name_fields
 from geobrep.batch.pipeline import (
     BuildBlocksStep,
     BuildStep,
@@ -161,7 +161,9 @@ def plan_outputs(
 ) -> list[tuple[Path, ...] | str]:
     """Per source, the file each write step produces; a message for a source that cannot run.
 
-    Names come from :func:`geobrep.batch.outputs.format_name` and paths from
+    A write step after a clip keeping both writes each half (in order, negative first), named
+    by :func:`geobrep.batch.outputs.half_name`. Names come from
+    :func:`geobrep.batch.outputs.format_name` and paths from
     :class:`~geobrep.batch.outputs.OutputFolder`: a name that is not a plain file name, or a
     path that resolves outside ``out_dir`` (through a symlink), is that source's failure. So is
     a name another source already claimed, or that is one of the inputs (the earlier source
@@ -174,17 +176,23 @@ def plan_outputs(
     inputs = {source.resolve() for source in sources}
     owners: dict[Path, Path] = {}
     plans: list[tuple[Path, ...] | str] = []
+    halves = pipeline.halves()
     for index, source in enumerate(sources):
-        fields = name_fields(source, index)
         try:
-            targets = tuple(folder.target(format_name(p, fields)) for p in patterns)
+            targets = tuple(
+                folder.target(half_name(pattern, name_fields(source, index, half)))
+                for pattern, step_halves in zip(patterns, halves, strict=True)
+                for half in step_halves
+            )
         except GeobrepError as exc:
             plans.append(str(exc))
             continue
         problem = None
-        for target in targets:
+        for position, target in enumerate(targets):
             key = target.resolve()
-            if key in inputs:
+            if key in {t.resolve() for t in targets[:position]}:
+                problem = f"output {target} is written twice (give the write steps other names)"
+            elif key in inputs:
                 problem = f"output {target} would overwrite an input"
             elif key in owners:
                 problem = f"output {target} is also the output of {owners[key]}"
@@ -309,16 +317,16 @@ def run_file(pipeline: Pipeline, source: Path, targets: tuple[Path, ...]) -> Pip
         numbered.insert(0, (0, ReadStep()))
     work = _Work(source=source, targets=targets, registries=registries())
     try:
-        scene = Scene()
+        branches: list[tuple[str, Scene]] = [("", Scene())]
         for work.number, body in numbered:
             work.kind = body.kind
             begun = time.perf_counter()
-            scene, notes = _APPLY.get(type(body), _operation)(body, scene, work)
+            branches, notes = _step(body, branches, work)
             reports.append(
                 StepReport(
                     step=work.number,
                     kind=work.kind,
-                    entities=len(scene.entities),
+                    entities=sum(len(scene.entities) for _, scene in branches),
                     seconds=time.perf_counter() - begun,
                     notes=tuple(notes),
                 )
@@ -373,6 +381,36 @@ def _write_outputs(work: _Work) -> dict[int, float]:
 
 # ------------------------------------------------------------------------------- steps
 Applied = tuple[Scene, list[str]]
+
+
+Branches = list[tuple[str, Scene]]
+"""The scenes a step works on, each with its half (``""`` until a clip keeps both sides)."""
+
+
+def _step(body: StepOptions, branches: Branches, work: _Work) -> tuple[Branches, list[str]]:
+    """One step on every half of the scene; a clip keeping both splits each half in two."""
+    result: Branches = []
+    notes: list[str] = []
+    for half, scene in branches:
+        if isinstance(body, ClipStep) and body.keep == "both":
+            for side, part in _clip_both(body, scene):
+                result.append((f"{half}-{side}" if half else side, part))
+            continue
+        applied, said = _APPLY.get(type(body), _operation)(body, scene, work)
+        result.append((half, applied))
+        named = half and not isinstance(body, WriteStep)  # a write's notes name its file
+        notes.extend(f"{half}: {note}" if named else note for note in said)
+    return result, notes
+
+
+def _clip_both(step: ClipStep, scene: Scene) -> list[tuple[str, Scene]]:
+    from geobrep.ops.clipping import clip
+
+    negative, positive = clip(scene, step.plane, "both", **_cut_keywords(step))
+    return [
+        (side, part if isinstance(part, Scene) else _empty(scene))
+        for side, part in (("negative", negative), ("positive", positive))
+    ]
 
 
 def _read(step: ReadStep, scene: Scene, work: _Work) -> Applied:

@@ -11,9 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Annotated, Any, Literal
-
-from pydantic import Field
+from typing import Annotated, Any
 
 from geobrep.batch.pipeline import ClipBoxStep, ClipStep
 from geobrep.cli.common import is_empty, read_input, refuse_empty, warn
@@ -74,22 +72,16 @@ class ClipCommand(PlaneShortcuts):
         Cli(group="plane", parse=comma_numbers(6), metavar="XMIN,XMAX,YMIN,YMAX,ZMIN,ZMAX"),
     ] = None
     """keep the inside of this box"""
-    keep: Literal["negative", "positive", "both"] = Field(default="negative")
-    """side to keep: negative (a·x+b·y+c·z+d < 0, the default), positive, or both"""
 
 
 def clip_options(command: Any, given: Mapping[str, Any]) -> ClipStep | ClipBoxStep:
     """The options of ``clip`` (or of ``clip_box`` for ``--box``) the arguments give."""
     if getattr(command, "box", None) is not None:
-        if command.keep != "negative":
+        if given.get("keep", "negative") != "negative":
             raise OptionsError("--box keeps the inside of the box: --keep does not apply")
-        data = {key: value for key, value in given.items() if key != "plane"}
+        data = {key: value for key, value in given.items() if key not in ("plane", "keep")}
         return options_from_args(ClipBoxStep, {**data, "bounds": command.box})  # type: ignore[no-any-return]
-    data = {**given, **command.operation_data()}
-    data.pop("keep", None)
-    if command.keep != "both":
-        data["keep"] = command.keep
-    return options_from_args(ClipStep, data)  # type: ignore[no-any-return]
+    return options_from_args(ClipStep, {**given, **command.operation_data()})  # type: ignore[no-any-return]
 
 
 def plane_text(args: PlaneShortcuts, options: Any = None) -> str:
@@ -168,7 +160,7 @@ def run(options: ClipStep | ClipBoxStep, args: ClipCommand) -> int:
         results.append((output, as_scene(result if result is not None else []), "inside of"))
     else:
         plane = Plane(*options.plane)
-        if args.keep == "both":
+        if options.keep == "both":
             negative, positive = clip(scene, plane, keep="both", **cut)
             for path, part, side in zip(
                 both_paths(output), (negative, positive), ("negative", "positive"), strict=True
@@ -187,7 +179,7 @@ def run(options: ClipStep | ClipBoxStep, args: ClipCommand) -> int:
         ],
         consequence="no file written",
     )
-    if plane is not None and args.keep != "both" and _misses(plane, scene):
+    if plane is not None and options.keep != "both" and _misses(plane, scene):
         warn(f"{output}: {plane_text(args, options)} does not meet the model ({span_text(scene)})")
     for path, part, _ in results:
         write(part, path, format=args.output_format)
