@@ -426,7 +426,13 @@ class WriteStep(StepOptions):
         """The registered format this step writes with."""
         if self.format is not None:
             return self.format
-        fields = {"stem": "x", "name": "x.x", "ext": ".x", "index": 0, "half": "x"}
+        fields: dict[str, str | int] = {
+            "stem": "x",
+            "name": "x.x",
+            "ext": ".x",
+            "index": 0,
+            "half": "x",
+        }
         sample = format_name(self.pattern(registries), fields)
         return registries.formats.choose_writer(Path(sample)).name
 

@@ -179,7 +179,8 @@ def run(options: ClipStep | ClipBoxStep, args: ClipCommand) -> int:
         ],
         consequence="no file written",
     )
-    if plane is not None and options.keep != "both" and _misses(plane, scene):
+    one_side = isinstance(options, ClipStep) and options.keep != "both"
+    if plane is not None and one_side and _misses(plane, scene):
         warn(f"{output}: {plane_text(args, options)} does not meet the model ({span_text(scene)})")
     for path, part, _ in results:
         write(part, path, format=args.output_format)

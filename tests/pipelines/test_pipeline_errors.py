@@ -34,8 +34,8 @@ def test_a_misspelt_step_option_names_step_kind_and_option(tmp_path: Path) -> No
 
 def test_a_bad_value_is_explained(tmp_path: Path) -> None:
     with pytest.raises(OptionsError, match=r"step 1 \(clip\): option 'keep': Input should be "
-                       r"'negative' or 'positive'"):  # fmt: skip
-        _load(tmp_path, "steps:\n  - clip: {plane: [1, 0, 0, 0], keep: both}\n"
+                       r"'negative', 'positive' or 'both'"):  # fmt: skip
+        _load(tmp_path, "steps:\n  - clip: {plane: [1, 0, 0, 0], keep: middle}\n"
                         "  - write: {format: vtu}\n")  # fmt: skip
 
 

@@ -75,7 +75,7 @@ def test_a_document_using_every_step_is_valid_for_both(
     [
         [{"clipp": {}}, {"write": {"format": "vtu"}}],  # unknown kind
         [{"clip": {"plane": [1, 0, 0]}}, {"write": {"format": "vtu"}}],  # 3 coefficients
-        [{"clip": {"plane": [1, 0, 0, 0], "keep": "both"}}, {"write": {"format": "vtu"}}],
+        [{"clip": {"plane": [1, 0, 0, 0], "keep": "middle"}}, {"write": {"format": "vtu"}}],
         [{"voxelize": {"depht": 5}}, {"write": {"format": "vtu"}}],  # typo
         [{"clip": {"plane": [1, 0, 0, 0]}, "keep": "negative"}, {"write": {"format": "vtu"}}],
         [],

@@ -125,7 +125,13 @@ def test_plain_fields_name_the_outputs(traversal: Path) -> None:
 
 def test_format_name_never_calls_str_format() -> None:
     fields = name_fields(Path("models/cake.tar.gz"), 7)
-    assert fields == {"stem": "cake", "name": "cake.tar.gz", "ext": ".tar.gz", "index": 7}
+    assert fields == {
+        "stem": "cake",
+        "name": "cake.tar.gz",
+        "ext": ".tar.gz",
+        "index": 7,
+        "half": "",
+    }
     assert format_name("{{{stem}}}-{index}{ext}", fields) == "{cake}-7.tar.gz"
     with pytest.raises(OptionsError):
         format_name("{index.real}", fields)
