@@ -657,9 +657,10 @@ class FormatRegistry(Registry[FormatSpec]):
             return self._named(format, path, "read")
         readers = self.readers()
         candidates = break_tie(_longest_match(readers, path))
+        head = _read_head(path) if candidates else b""
         if len(candidates) == 1:
-            return candidates[0]
-        head = _read_head(path)
+            return self._extension_or_content(candidates[0], readers, head)
+        head = head or _read_head(path)
         pool = candidates or readers
         sniffed = [spec for spec in pool if self._sniffs(spec, head)]
         specific = [spec for spec in sniffed if not spec.generic_content]
@@ -725,6 +726,24 @@ class FormatRegistry(Registry[FormatSpec]):
             f"pass format='<name>' to choose one",
             path=path,
         )
+
+    def _extension_or_content(
+        self, chosen: FormatSpec, readers: list[FormatSpec], head: bytes
+    ) -> FormatSpec:
+        """The format an extension names, unless its sniffer refuses the content and exactly one
+        other format knows it (a GeoJSON file named ``.json``, the extension of 3D Tiles).
+
+        Without a sniffer, or with no head, or when no other specific format claims the content,
+        the extension's format reads it (and its reader says what is wrong).
+        """
+        if chosen.sniff is None or not head or self._sniffs(chosen, head):
+            return chosen
+        others = [
+            spec
+            for spec in readers
+            if spec is not chosen and not spec.generic_content and self._sniffs(spec, head)
+        ]
+        return others[0] if len(others) == 1 else chosen
 
     @staticmethod
     def _sniffs(spec: FormatSpec, head: bytes) -> bool:

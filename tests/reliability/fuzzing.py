@@ -107,6 +107,7 @@ WRITE_VARIANTS: dict[str, list[dict[str, object]]] = {
     "ply": [{"binary": False}],
     "stl": [{"binary": True}],
     "csv": [{"delimiter": " "}],
+    "3dtiles": [{"longitude": 5.7, "latitude": 45.2, "height": 200.0}],  # a local CRS needs one
 }
 
 
