@@ -2,22 +2,28 @@
 
 Colour by entity, block or property, optionally cutting away the side of a plane its normal
 points to or drawing a section; a legend, axes in world coordinates, a scale bar and the CRS in
-the title. Rendering goes through the registered ``png`` format (pyvista, extra ``viz``).
+the title. Rendering goes through the registered ``png`` format (pyvista, extra ``viz``). The
+flags are derived from :class:`RenderCommand` (:func:`~geobrep.host.operations.add_arguments`).
 """
 
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import Annotated, Any, Literal
 
-from geobrep.cli.common import add_allow_empty, format_name, read_input
+from pydantic import BaseModel, ConfigDict
+
+from geobrep.cli.common import format_name, read_input
 from geobrep.errors import OptionsError
+from geobrep.host.operations import Cli, add_arguments, options_from_args
 from geobrep.ops.io import write
 
-__all__ = ["add_parser", "run"]
+__all__ = ["RenderCommand", "add_parser", "render", "run"]
+
+Triple = tuple[float, float, float]
 
 
-def _triple(text: str) -> tuple[float, float, float]:
+def _triple(text: str) -> Triple:
     try:
         values = tuple(float(v) for v in text.replace(",", " ").split())
     except ValueError:
@@ -27,108 +33,99 @@ def _triple(text: str) -> tuple[float, float, float]:
     return values[0], values[1], values[2]
 
 
+class RenderCommand(BaseModel):
+    """The files and options of ``geobrep render`` (the ``png`` writer's, as flags)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+    scene: Annotated[str, Cli(positional=True)]
+    """model file (any readable format)"""
+    output: Annotated[str, Cli(positional=True)]
+    """picture to write (.png)"""
+    format: Annotated[str | None, Cli(parse=format_name("read"))] = None
+    """input format, when the extension is not enough"""
+    color_by: Literal["entity", "block", "property"] | None = None
+    """colour each entity, each block, or by a property (default: entity; property when
+    --property is given)"""
+    property: str | None = None
+    """property to colour by"""
+    clip_origin: Annotated[Triple | None, Cli(parse=_triple, metavar="X,Y,Z")] = None
+    """a point of the cut-away plane"""
+    clip_normal: Annotated[Triple | None, Cli(parse=_triple, metavar="NX,NY,NZ")] = None
+    """normal of the cut-away plane (the side it points to is removed)"""
+    section_origin: Annotated[Triple | None, Cli(parse=_triple, metavar="X,Y,Z")] = None
+    """a point of the section plane"""
+    section_normal: Annotated[Triple | None, Cli(parse=_triple, metavar="NX,NY,NZ")] = None
+    """normal of the section plane: the side it points to is removed, blocks are closed by the
+    cut, and the picture looks at the cut"""
+    view: Literal["isometric", "top", "bottom", "north", "south", "east", "west"] | None = None
+    """where the camera looks from (default: isometric, or square to the section)"""
+    azimuth: Annotated[float, Cli(metavar="DEG")] = 0.0
+    """turn the camera about the vertical by DEG degrees"""
+    elevation: Annotated[float, Cli(metavar="DEG")] = 0.0
+    """raise the camera by DEG degrees"""
+    title: str | None = None
+    """the picture's title (default: model name and CRS)"""
+    legend: Annotated[bool, Cli(negate="--no-legend")] = True
+    """no legend of names and colours"""
+    axes: Annotated[bool, Cli(negate="--no-axes")] = True
+    """no axes with coordinates"""
+    scale_bar: Annotated[bool, Cli(negate="--no-scale-bar")] = True
+    """no scale bar"""
+    size: Annotated[tuple[int, int], Cli(nargs=2, parse=int, metavar=("W", "H"))] = (1200, 900)
+    """picture size in pixels"""
+    edges: bool = False
+    """draw triangle edges"""
+    vertical_exaggeration: Annotated[float, Cli(metavar="F")] = 1.0
+    """scale of z relative to x and y"""
+    allow_empty: bool = False
+    """accept a result with nothing in it (otherwise: a warning and exit 4)"""
+
+    def png_options(self) -> dict[str, Any]:
+        """The options of the ``png`` writer these flags give."""
+        for name in ("clip", "section"):
+            if (getattr(self, f"{name}_origin") is None) != (
+                getattr(self, f"{name}_normal") is None
+            ):
+                raise OptionsError(f"--{name}-origin and --{name}-normal go together")
+        return {
+            "color_by": self.color_by or ("property" if self.property else "entity"),
+            "property": self.property,
+            "clip_origin": self.clip_origin,
+            "clip_normal": self.clip_normal,
+            "window_size": tuple(self.size),
+            "show_edges": self.edges,
+            "vertical_exaggeration": self.vertical_exaggeration,
+            "section_origin": self.section_origin,
+            "section_normal": self.section_normal,
+            "view": self.view,
+            "azimuth": self.azimuth,
+            "elevation": self.elevation,
+            "title": self.title,
+            "legend": self.legend,
+            "axes": self.axes,
+            "scale_bar": self.scale_bar,
+        }
+
+
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "render",
         help="render a picture of a model (PNG, off-screen)",
         description="Render a model to a PNG file without a display.",
     )
-    parser.add_argument("scene", help="model file (any readable format)")
-    parser.add_argument("output", help="picture to write (.png)")
-    parser.add_argument(
-        "--format", type=format_name("read"), help="input format, when the extension is not enough"
-    )
-    parser.add_argument(
-        "--color-by",
-        choices=("entity", "block", "property"),
-        default=None,
-        help="colour each entity, each block, or by a property "
-        "(default: entity; property when --property is given)",
-    )
-    parser.add_argument("--property", help="property to colour by")
-    parser.add_argument(
-        "--clip-origin", type=_triple, metavar="X,Y,Z", help="a point of the cut-away plane"
-    )
-    parser.add_argument(
-        "--clip-normal",
-        type=_triple,
-        metavar="NX,NY,NZ",
-        help="normal of the cut-away plane (the side it points to is removed)",
-    )
-    parser.add_argument(
-        "--section-origin", type=_triple, metavar="X,Y,Z", help="a point of the section plane"
-    )
-    parser.add_argument(
-        "--section-normal",
-        type=_triple,
-        metavar="NX,NY,NZ",
-        help="normal of the section plane: the side it points to is removed, blocks are "
-        "closed by the cut, and the picture looks at the cut",
-    )
-    parser.add_argument(
-        "--view",
-        choices=("isometric", "top", "bottom", "north", "south", "east", "west"),
-        help="where the camera looks from (default: isometric, or square to the section)",
-    )
-    parser.add_argument(
-        "--azimuth",
-        type=float,
-        default=0.0,
-        metavar="DEG",
-        help="turn the camera about the vertical by DEG degrees",
-    )
-    parser.add_argument(
-        "--elevation",
-        type=float,
-        default=0.0,
-        metavar="DEG",
-        help="raise the camera by DEG degrees",
-    )
-    parser.add_argument("--title", help="the picture's title (default: model name and CRS)")
-    parser.add_argument("--no-legend", action="store_true", help="no legend of names and colours")
-    parser.add_argument("--no-axes", action="store_true", help="no axes with coordinates")
-    parser.add_argument("--no-scale-bar", action="store_true", help="no scale bar")
-    parser.add_argument(
-        "--size",
-        type=int,
-        nargs=2,
-        metavar=("W", "H"),
-        default=(1200, 900),
-        help="picture size in pixels",
-    )
-    parser.add_argument("--edges", action="store_true", help="draw triangle edges")
-    parser.add_argument("--vertical-exaggeration", type=float, default=1.0, metavar="F")
-    add_allow_empty(parser)
+    add_arguments(parser, RenderCommand)
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    if (args.clip_origin is None) != (args.clip_normal is None):
-        raise OptionsError("--clip-origin and --clip-normal go together")
-    if (args.section_origin is None) != (args.section_normal is None):
-        raise OptionsError("--section-origin and --section-normal go together")
-    color_by = args.color_by or ("property" if args.property else "entity")
-    scene = read_input(args, args.scene, format=args.format)
-    path = write(
-        scene,
-        args.output,
-        format="png",
-        color_by=color_by,
-        property=args.property,
-        clip_origin=args.clip_origin,
-        clip_normal=args.clip_normal,
-        window_size=tuple(args.size),
-        show_edges=args.edges,
-        vertical_exaggeration=args.vertical_exaggeration,
-        section_origin=args.section_origin,
-        section_normal=args.section_normal,
-        view=args.view,
-        azimuth=args.azimuth,
-        elevation=args.elevation,
-        title=args.title,
-        legend=not args.no_legend,
-        axes=not args.no_axes,
-        scale_bar=not args.no_scale_bar,
-    )
+    return render(options_from_args(RenderCommand, args))
+
+
+def render(command: RenderCommand) -> int:
+    """Read the model and write its picture."""
+    options = command.png_options()
+    scene = read_input(command, command.scene, format=command.format)
+    path = write(scene, command.output, format="png", **options)
     print(f"wrote {path}")
     return 0
