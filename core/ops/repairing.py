@@ -37,6 +37,7 @@ from geobrep.model.entities import Entity, Surface
 from geobrep.model.orientation import orient_blocks, orient_patches
 from geobrep.model.properties import Property
 from geobrep.model.scene import Scene
+from geobrep.ops._rederive import connectivity, rederive_patches
 from geobrep.ops.inspection import Progress, _as_inspected_scene, _checked_tolerance, inspect
 
 __all__ = ["ACTIONS", "RepairAction", "RepairReport", "repair"]
@@ -63,6 +64,9 @@ ADDRESSES = {
     "orient_blocks": "region_sides",
 }
 _ROUNDS = 4
+#: The step after the mesh actions (and before orienting) re-deriving patches and blocks.
+REDERIVE = "rederive_patches"
+_ORIENTING = ("orient", "orient_blocks")
 
 
 class RepairAction(BaseModel):
@@ -320,43 +324,35 @@ def repair(
     """Mend the defects ``actions`` address (default: all of :data:`ACTIONS`), at ``tolerance``
     (default: the one :func:`geobrep.inspect` derives from the data's precision).
 
-    ``progress(step, done, total, seconds)`` is called after the inspection before, each action
-    and the inspection after (steps ``inspect before``, the action names, ``inspect after``)."""
+    Where the mesh actions changed a surface's connectivity (a weld joining two patches'
+    borders, an edge split at a T-junction), patches, topology and blocks are re-derived by the
+    block builder before orienting (step ``rederive_patches``, see :mod:`geobrep.ops._rederive`),
+    keeping properties, ids and names.
+
+    ``progress(step, done, total, seconds)`` is called after the inspection before, each step
+    and the inspection after (steps ``inspect before``, the step names, ``inspect after``)."""
     source = _as_inspected_scene(scene)
     chosen = _chosen_actions(actions)
     checks = [ADDRESSES[a] for a in chosen]
-    steps, clock = len(chosen) + 2, time.perf_counter()
+    steps, clock = len(chosen) + 3, time.perf_counter()
     before = inspect(source, checks, _checked_tolerance(tolerance), max_listed=0)
     if progress is not None:
         progress("inspect before", 1, steps, time.perf_counter() - clock)
     tol = before.tolerance if before.tolerance is not None else 0.0
+    signatures = {int(s.id or 0): connectivity(s) for s in source.surfaces}
     done: list[RepairAction] = []
     current = source
-    for done_steps, action in enumerate(chosen, start=2):
+    plan = [a for a in chosen if a not in _ORIENTING] + [REDERIVE]
+    plan += [a for a in chosen if a in _ORIENTING]
+    for number, action in enumerate(plan, start=2):
         clock = time.perf_counter()
-        notes: list[str] = []
-        per_entity: dict[str, int] = {}
-        if action in _PER_SURFACE:
-            replaced: dict[int, Entity] = {}
-            for surface in current.surfaces:
-                fixed, count = _PER_SURFACE[action](surface, tol)
-                if count:
-                    replaced[int(surface.id or 0)] = fixed
-                    per_entity[surface.name or surface.label] = count
-            current = current.replace(
-                entities=[replaced.get(int(e.id or 0), e) for e in current.entities]
-            )
-            total = sum(per_entity.values())
-        elif action == "split_t_junctions":
-            current, total, notes = _split_t_junctions(current, tol)
+        if action == REDERIVE:
+            current, step = _rederive(current, signatures, tol)
         else:
-            current, notes = orient_blocks(current)
-            total = sum(1 for n in notes if "reversed" in n)
-        done.append(
-            RepairAction(action=action, count=total, entities=per_entity, notes=tuple(notes))
-        )
+            current, step = _apply(action, current, tol)
+        done.append(step)
         if progress is not None:
-            progress(action, done_steps, steps, time.perf_counter() - clock)
+            progress(action, number, steps, time.perf_counter() - clock)
     clock = time.perf_counter()
     after = inspect(current, checks, tol, max_listed=0)
     if progress is not None:
@@ -365,3 +361,49 @@ def repair(
         tolerance=tol, actions=tuple(done), before=before.counts(), after=after.counts()
     )
     return current, report
+
+
+def _apply(action: str, current: Scene, tol: float) -> tuple[Scene, RepairAction]:
+    """One repair action on the scene, and what it did."""
+    notes: list[str] = []
+    per_entity: dict[str, int] = {}
+    if action in _PER_SURFACE:
+        replaced: dict[int, Entity] = {}
+        for surface in current.surfaces:
+            fixed, count = _PER_SURFACE[action](surface, tol)
+            if count:
+                replaced[int(surface.id or 0)] = fixed
+                per_entity[surface.name or surface.label] = count
+        current = current.replace(
+            entities=[replaced.get(int(e.id or 0), e) for e in current.entities]
+        )
+        total = sum(per_entity.values())
+    elif action == "split_t_junctions":
+        current, total, notes = _split_t_junctions(current, tol)
+    else:
+        current, notes = orient_blocks(current)
+        total = sum(1 for n in notes if "reversed" in n)
+    return current, RepairAction(
+        action=action, count=total, entities=per_entity, notes=tuple(notes)
+    )
+
+
+def _rederive(
+    current: Scene, signatures: dict[int, tuple[int, int]], tol: float
+) -> tuple[Scene, RepairAction]:
+    """Patches and blocks re-derived by the builder when the repairs so far changed the
+    connectivity of a surface (its edges or border edges); count: the surfaces concerned."""
+    changed = {
+        int(s.id or 0)
+        for s in current.surfaces
+        if signatures.get(int(s.id or 0)) != connectivity(s)
+    }
+    repaired, notes = rederive_patches(current, changed, tol)
+    names = {int(s.id or 0): s.name or s.label for s in current.surfaces}
+    count = len(changed) if repaired is not current else 0
+    return repaired, RepairAction(
+        action=REDERIVE,
+        count=count,
+        entities={names[k]: 1 for k in sorted(changed)} if count else {},
+        notes=tuple(notes),
+    )
