@@ -31,7 +31,7 @@ from multiprocessing.connection import Connection
 from multiprocessing.context import DefaultContext
 from os import PathLike
 from pathlib import Path
-from typing import Any, Literal, TypeVar
+from typing import Any, Generic, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict
 
@@ -50,6 +50,9 @@ from geobrep.ops.io import read, write
 __all__ = [
     "ConversionSummary",
     "FileReport",
+    "PipelineFileReport",
+    "PipelineSummary",
+    "StepReport",
     "WorkerDiedError",
     "convert",
     "convert_file",
@@ -80,39 +83,98 @@ class FileReport(BaseModel):
     seconds: float = 0.0
 
 
-class ConversionSummary(BaseModel):
-    """Every file's report, in input order."""
+class StepReport(BaseModel):
+    """What one pipeline step did to one input."""
 
     model_config = ConfigDict(frozen=True)
 
-    reports: tuple[FileReport, ...]
+    step: int
+    """The step's number, counted from 1 (0: the implicit read when the pipeline has none)."""
+    kind: str
+    entities: int = 0
+    """Entities in the scene after the step."""
+    seconds: float = 0.0
+    notes: tuple[str, ...] = ()
+    """What the step wants known: fit accuracy, octree size, what an output format drops."""
+
+
+class PipelineFileReport(BaseModel):
+    """The outcome of one input of a pipeline: its outputs, or the step that failed and why."""
+
+    model_config = ConfigDict(frozen=True)
+
+    source: Path
+    status: Literal["done", "failed"]
+    outputs: tuple[Path, ...] = ()
+    error: str | None = None
+    failed_step: int | None = None
+    steps: tuple[StepReport, ...] = ()
+    lost: tuple[str, ...] = ()
+    """What the output formats could not hold, per output file."""
+    seconds: float = 0.0
+
+
+Report = TypeVar("Report", bound=FileReport | PipelineFileReport)
+
+
+class PipelineSummary(BaseModel, Generic[Report]):
+    """Every input's report, in input order: the one summary of :func:`convert` (its reports
+    are :class:`FileReport`) and of :func:`geobrep.batch.pipeline_run.run_pipeline`
+    (:class:`PipelineFileReport`). ``ConversionSummary`` is this type.
+
+    >>> PipelineSummary(reports=()).table().splitlines()[-1]
+    '0 done, 0 failed'
+    """
+
+    model_config = ConfigDict(frozen=True)
+
+    reports: tuple[Report, ...]
 
     @property
     def ok(self) -> bool:
-        """True when every file converted."""
-        return all(r.status == "converted" for r in self.reports)
+        """True when every input went through."""
+        return all(r.status != "failed" for r in self.reports)
 
     @property
-    def failed(self) -> tuple[FileReport, ...]:
-        """The reports of the files that failed."""
+    def failed(self) -> tuple[Report, ...]:
+        """The reports of the inputs that failed."""
         return tuple(r for r in self.reports if r.status == "failed")
 
     @property
-    def converted(self) -> tuple[FileReport, ...]:
-        """The reports of the files written."""
-        return tuple(r for r in self.reports if r.status == "converted")
+    def done(self) -> tuple[Report, ...]:
+        """The reports of the inputs whose outputs were written."""
+        return tuple(r for r in self.reports if r.status != "failed")
+
+    @property
+    def converted(self) -> tuple[Report, ...]:
+        """The same as :attr:`done` (the files written)."""
+        return self.done
 
     def table(self) -> str:
-        """A plain-text table: one row per file, then the totals.
+        """A plain-text table: one row per input, then the totals.
 
-        >>> ConversionSummary(reports=()).table().splitlines()[-1]
-        '0 converted, 0 failed'
+        >>> ConversionSummary(reports=(FileReport(source="a.ts", status="failed", error="bad"),
+        ...     )).table().splitlines()[-1]
+        '0 converted, 1 failed'
         """
-        rows = [("status", "source", "target", "notes")]
+        if any(isinstance(r, FileReport) for r in self.reports):
+            rows = [("status", "source", "target", "notes")]
+            for r in self.reports:
+                if isinstance(r, FileReport):
+                    notes = r.error if r.error else ("; ".join(r.lost) or "nothing lost")
+                    rows.append((r.status, str(r.source), str(r.target or "-"), notes or ""))
+            return report_table(rows, f"{len(self.done)} converted, {len(self.failed)} failed")
+        rows = [("status", "source", "outputs", "notes")]
         for r in self.reports:
-            notes = r.error if r.error else ("; ".join(r.lost) or "nothing lost")
-            rows.append((r.status, str(r.source), str(r.target or "-"), notes or ""))
-        return report_table(rows, f"{len(self.converted)} converted, {len(self.failed)} failed")
+            if isinstance(r, PipelineFileReport):
+                outputs = ", ".join(p.name for p in r.outputs) or "-"
+                notes = r.error or "; ".join(n for s in r.steps for n in s.notes) or ""
+                rows.append((r.status, str(r.source), outputs, notes))
+        return report_table(rows, f"{len(self.done)} done, {len(self.failed)} failed")
+
+
+ConversionSummary = PipelineSummary
+"""The summary of :func:`convert`: the same type as a pipeline's."""
 
 
 def report_table(rows: Sequence[tuple[str, str, str, str]], totals: str) -> str:
@@ -332,7 +394,7 @@ def convert(
     write_options: dict[str, Any] | None = None,
     progress: Progress | None = None,
     verify: bool = False,
-) -> ConversionSummary:
+) -> ConversionSummary[FileReport]:
     """Convert files; returns the per-file reports (it never stops at a bad file).
 
     ``convert("in.ts", "out.vtu")`` converts one file; ``convert(["a/*.ts"], out_dir="out",
@@ -380,7 +442,7 @@ def convert(
         done(indices[position], report)
 
     run_each(convert_file, arguments, finished, jobs=jobs if len(work) > 1 else 1, client=client)
-    return ConversionSummary(reports=tuple(results[i] for i in range(total)))
+    return PipelineSummary[FileReport](reports=tuple(results[i] for i in range(total)))
 
 
 def run_each(

@@ -25,12 +25,18 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict
 
-from geobrep.batch.conversion import expand, report_table, run_each, worker_failure
+from geobrep.batch.conversion import (
+    PipelineFileReport,
+    PipelineSummary,
+    StepReport,
+    expand,
+    run_each,
+    worker_failure,
+)
 from geobrep.batch.outputs import OutputFolder, contained, half_name, name_fields
 from geobrep.batch.pipeline import (
     BuildBlocksStep,
@@ -78,73 +84,6 @@ PathArg = str | PathLike[str]
 Progress = Callable[["PipelineFileReport", int, int], None]
 
 #: Extensions read as ``x, y, z`` point columns when no registered format claims them.
-
-
-class StepReport(BaseModel):
-    """What one step did to one input."""
-
-    model_config = ConfigDict(frozen=True)
-
-    step: int
-    """The step's number, counted from 1 (0: the implicit read when the pipeline has none)."""
-    kind: str
-    entities: int = 0
-    """Entities in the scene after the step."""
-    seconds: float = 0.0
-    notes: tuple[str, ...] = ()
-    """What the step wants known: fit accuracy, octree size, what an output format drops."""
-
-
-class PipelineFileReport(BaseModel):
-    """The outcome of one input: its outputs, or the step that failed and why."""
-
-    model_config = ConfigDict(frozen=True)
-
-    source: Path
-    status: Literal["done", "failed"]
-    outputs: tuple[Path, ...] = ()
-    error: str | None = None
-    failed_step: int | None = None
-    steps: tuple[StepReport, ...] = ()
-    lost: tuple[str, ...] = ()
-    """What the output formats could not hold, per output file."""
-    seconds: float = 0.0
-
-
-class PipelineSummary(BaseModel):
-    """Every input's report, in input order."""
-
-    model_config = ConfigDict(frozen=True)
-
-    reports: tuple[PipelineFileReport, ...]
-
-    @property
-    def ok(self) -> bool:
-        """True when every input went through."""
-        return all(r.status == "done" for r in self.reports)
-
-    @property
-    def failed(self) -> tuple[PipelineFileReport, ...]:
-        """The reports of the inputs that failed."""
-        return tuple(r for r in self.reports if r.status == "failed")
-
-    @property
-    def done(self) -> tuple[PipelineFileReport, ...]:
-        """The reports of the inputs whose outputs were written."""
-        return tuple(r for r in self.reports if r.status == "done")
-
-    def table(self) -> str:
-        """A plain-text table: one row per input, then the totals.
-
-        >>> PipelineSummary(reports=()).table().splitlines()[-1]
-        '0 done, 0 failed'
-        """
-        rows = [("status", "source", "outputs", "notes")]
-        for r in self.reports:
-            outputs = ", ".join(p.name for p in r.outputs) or "-"
-            notes = r.error or "; ".join(n for s in r.steps for n in s.notes) or ""
-            rows.append((r.status, str(r.source), outputs, notes))
-        return report_table(rows, f"{len(self.done)} done, {len(self.failed)} failed")
 
 
 # ------------------------------------------------------------------------------- planning
@@ -214,7 +153,7 @@ def run_pipeline(
     jobs: int = 1,
     client: Any = None,
     progress: Progress | None = None,
-) -> PipelineSummary:
+) -> PipelineSummary[PipelineFileReport]:
     """Run a pipeline over its inputs; returns the per-input reports (it never stops at one).
 
     ``pipeline`` is a :class:`~geobrep.batch.pipeline.Pipeline`, the path of a pipeline file, or its
@@ -280,7 +219,7 @@ def run_pipeline(
         done(indices[position], report)
 
     run_each(run_file, arguments, finished, jobs=jobs, client=client)
-    return PipelineSummary(reports=tuple(results[i] for i in range(total)))
+    return PipelineSummary[PipelineFileReport](reports=tuple(results[i] for i in range(total)))
 
 
 # ------------------------------------------------------------------------------- one input

@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 from typing import Any, Protocol
 
-from geobrep.batch.conversion import ConversionSummary, convert
+from geobrep.batch.conversion import ConversionSummary, FileReport, convert
 from geobrep.cli.common import add_allow_empty, format_name, refuse_empty
 from geobrep.errors import OptionsError
 
@@ -131,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print(summary: ConversionSummary, as_json: bool) -> None:
+def _print(summary: ConversionSummary[FileReport], as_json: bool) -> None:
     if as_json:
         print(json.dumps([r.model_dump(mode="json") for r in summary.reports], indent=2))
     else:

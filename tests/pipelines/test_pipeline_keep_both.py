@@ -108,3 +108,20 @@ def test_the_clip_function_refuses_both(layer_cake: geobrep.Scene) -> None:
     [spec] = [s for s in builtin_operations() if s.name == "clip"]
     with pytest.raises(OptionsError, match="keep 'both' gives two scenes"):
         spec(layer_cake, plane=[1, 0, 0, -X_CUT], keep="both")
+
+
+def test_one_summary_type_for_convert_and_pipelines(tmp_path: Path, cake_file: Path) -> None:
+    assert geobrep.ConversionSummary is geobrep.PipelineSummary
+    converted = geobrep.convert(cake_file, tmp_path / "vtu", to="vtu")
+    piped = run_pipeline(
+        {"inputs": [str(cake_file)], "output": str(tmp_path / "out"),
+         "steps": [{"write": {"format": "vtu"}}]}
+    )  # fmt: skip
+    for summary in (converted, piped):
+        assert isinstance(summary, geobrep.PipelineSummary)
+        assert summary.ok
+        assert summary.done == summary.converted
+        assert len(summary.done) == 1
+        assert summary.failed == ()
+    assert converted.table().splitlines()[-1] == "1 converted, 0 failed"
+    assert piped.table().splitlines()[-1] == "1 done, 0 failed"
