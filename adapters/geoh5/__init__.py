@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from geobrep.adapters._file_format import file_format
-from geobrep.errors import FormatError, MissingDependencyError
+from geobrep.errors import FormatError, import_optional
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry, NoOptions
 from geobrep.model.entities import RegularGrid
@@ -42,22 +42,15 @@ CAPABILITIES = FormatCapabilities(
 )
 
 
-def _h5py(feature: str) -> None:
-    try:
-        import h5py  # noqa: F401
-    except ImportError as exc:
-        raise MissingDependencyError("h5py", "geoh5", feature) from exc
-
-
 def _read(path: Path) -> Scene:
-    _h5py(f"reading geoh5 ({path.name})")
+    import_optional("h5py", "geoh5", f"reading geoh5 ({path.name})")
     from geobrep.adapters.geoh5._workspace import read_geoh5
 
     return read_geoh5(path)
 
 
 def _write(scene: Scene, path: Path, options: NoOptions) -> None:
-    _h5py(f"writing geoh5 ({path.name})")
+    import_optional("h5py", "geoh5", f"writing geoh5 ({path.name})")
     from geobrep.adapters.geoh5._workspace import write_geoh5
 
     if not scene.entities:

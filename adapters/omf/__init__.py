@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from geobrep.adapters._file_format import file_format
-from geobrep.errors import FormatError, MissingDependencyError
+from geobrep.errors import FormatError, import_optional
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry, NoOptions
 from geobrep.model.scene import Scene
@@ -45,13 +45,6 @@ CAPABILITIES = FormatCapabilities(
 _KEPT_METADATA = frozenset({"color", "description", "grid"})
 
 
-def _omf(feature: str) -> None:
-    try:
-        import omf  # noqa: F401
-    except ImportError as exc:
-        raise MissingDependencyError("omf", "omf", feature) from exc
-
-
 @contextlib.contextmanager
 def _quiet() -> Iterator[None]:
     """Without the NumPy 2 deprecation notes of omf 1.0's vectormath (one per array)."""
@@ -61,7 +54,7 @@ def _quiet() -> Iterator[None]:
 
 
 def _read(path: Path) -> Scene:
-    _omf(f"reading OMF ({path.name})")
+    import_optional("omf", "omf", f"reading OMF ({path.name})")
     from geobrep.adapters.omf._project import read_omf
 
     with _quiet():
@@ -69,7 +62,7 @@ def _read(path: Path) -> Scene:
 
 
 def _write(scene: Scene, path: Path, options: NoOptions) -> None:
-    _omf(f"writing OMF ({path.name})")
+    import_optional("omf", "omf", f"writing OMF ({path.name})")
     from geobrep.adapters.omf._project import write_omf
 
     if not scene.entities:

@@ -24,7 +24,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict
 
 from geobrep.adapters._file_format import file_format
-from geobrep.errors import FormatError, MissingDependencyError
+from geobrep.errors import FormatError, import_optional
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry
 from geobrep.model.scene import Scene
@@ -54,22 +54,15 @@ class ResqmlOptions(BaseModel):
     change a coordinate in the last bit is refused, so the round trip stays exact)."""
 
 
-def _resqpy(feature: str) -> None:
-    try:
-        import resqpy  # noqa: F401
-    except ImportError as exc:
-        raise MissingDependencyError("resqpy", "resqml", feature) from exc
-
-
 def _read(path: Path) -> Scene:
-    _resqpy(f"reading RESQML ({path.name})")
+    import_optional("resqpy", "resqml", f"reading RESQML ({path.name})")
     from geobrep.adapters.resqml._reader import read_resqml
 
     return read_resqml(path)
 
 
 def _write(scene: Scene, path: Path, options: ResqmlOptions) -> None:
-    _resqpy(f"writing RESQML ({path.name})")
+    import_optional("resqpy", "resqml", f"writing RESQML ({path.name})")
     from geobrep.adapters.resqml._writer import write_resqml
 
     if not scene.entities:
