@@ -155,12 +155,11 @@ def parse_numbers(text: bytes | str) -> NDArray[np.float64]:
     if not data.strip():
         return np.zeros(0)
     with warnings.catch_warnings():
-        warnings.simplefilter("error")
+        warnings.simplefilter("error")  # numpy warns, not raises, when it stops at a bad token
         try:
             return np.fromstring(data, dtype=np.float64, sep=" ")
         except (ValueError, DeprecationWarning):
-            pass
-    bad = next((t for t in data.split() if not _is_float(t)), data.split()[0])
+            bad = next((t for t in data.split() if not _is_float(t)), data.split()[0])
     raise ValueError(f"{bad[:40]!r} is not a number")
 
 
