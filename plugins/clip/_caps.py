@@ -267,7 +267,14 @@ def _triangle_areas(coordinates: FloatArray, positions: IntArray) -> FloatArray:
 
 
 def _restore_skipped(positions: IntArray, ends: IntArray, coordinates: FloatArray) -> IntArray:
-    """Put back ring vertices earcut skipped (collinear runs), splitting spanning triangles."""
+    """Put back ring vertices earcut skipped, so every ring edge is an edge of the triangles.
+
+    Earcut drops a vertex on a straight run of a ring, and a vertex that coincides with its
+    neighbour (two cut points at one corner of a box). A triangle whose edge skips a straight run
+    becomes a fan over the run's vertices; what is still missing afterwards is a gap of zero area
+    between the ring and the triangles (the coincident corners), which is closed by a fan of its
+    own. The caller checks the total area, so no filling can go unnoticed.
+    """
     total = int(ends[-1])
     if np.unique(positions).shape[0] == total or positions.shape[0] == 0:
         return positions
@@ -277,18 +284,30 @@ def _restore_skipped(positions: IntArray, ends: IntArray, coordinates: FloatArra
     last = following == ends[ring_of]
     following[last] = starts[ring_of[last]]
     ring_edges = set(zip(range(total), following.tolist(), strict=True))
+    extent = float(np.ptp(coordinates, axis=0).max())
+    tolerance = 1e-12 * extent * extent
     rows = positions.tolist()
     for _ in range(total):
-        rows, changed = _split_spanning(rows, ring_edges, following, total)
+        rows, changed = _split_spanning(rows, ring_edges, following, coordinates, tolerance)
         if not changed:
             break
+    rows.extend(_fill_gaps(rows, ring_edges))
     return np.asarray(rows, dtype=np.int64).reshape(-1, 3)
 
 
 def _split_spanning(
-    rows: list[list[int]], ring_edges: set[tuple[int, int]], following: IntArray, total: int
+    rows: list[list[int]],
+    ring_edges: set[tuple[int, int]],
+    following: IntArray,
+    coordinates: FloatArray,
+    tolerance: float,
 ) -> tuple[list[list[int]], bool]:
-    """One pass: each triangle with a boundary edge that skips ring vertices becomes a fan."""
+    """One pass: each triangle with an edge along a straight run of the ring becomes a fan.
+
+    The run from ``a`` to ``b`` must lie on the edge: the fan's triangles may not turn over
+    and together cover the triangle they replace, otherwise the edge is left as it is.
+    """
+    total = int(following.shape[0])
     directed = {(t[k], t[(k + 1) % 3]) for t in rows for k in range(3)}
     result: list[list[int]] = []
     changed = False
@@ -305,9 +324,40 @@ def _split_spanning(
                 chain.append(current)
             if current != b:
                 continue
-            result.extend([chain[j], chain[j + 1], apex] for j in range(len(chain) - 1))
+            fan = np.array([[chain[j], chain[j + 1], apex] for j in range(len(chain) - 1)])
+            areas = _triangle_areas(coordinates, fan)
+            whole = float(_triangle_areas(coordinates, np.array([[a, b, apex]]))[0])
+            if (areas < -tolerance).any() or abs(float(areas.sum()) - whole) > tolerance:
+                continue
+            result.extend(fan.tolist())
             replaced = changed = True
             break
         if not replaced:
             result.append(triangle)
     return result, changed
+
+
+def _fill_gaps(rows: list[list[int]], ring_edges: set[tuple[int, int]]) -> list[list[int]]:
+    """Fans closing what lies between the ring and the triangles: loops made of the ring edges
+    no triangle has and the reverse of the triangles' edges that are neither shared nor ring
+    edges."""
+    directed = {(t[k], t[(k + 1) % 3]) for t in rows for k in range(3)}
+    gap_edges = [edge for edge in ring_edges if edge not in directed]
+    gap_edges += [
+        (b, a) for a, b in directed if (b, a) not in directed and (a, b) not in ring_edges
+    ]
+    if not gap_edges:
+        return []
+    successors: dict[int, list[int]] = {}
+    for a, b in sorted(gap_edges):
+        successors.setdefault(a, []).append(b)
+    fans: list[list[int]] = []
+    for start in sorted(successors):
+        while successors.get(start):
+            loop = [start]
+            current = successors[start].pop()
+            while current != start and successors.get(current):
+                loop.append(current)
+                current = successors[current].pop()
+            fans.extend([loop[0], loop[j], loop[j + 1]] for j in range(1, len(loop) - 1))
+    return fans

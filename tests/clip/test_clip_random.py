@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from clip_shapes import assert_closed_half, cap_area
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 from geobrep import Plane, Surface
@@ -101,6 +101,8 @@ def test_planes_through_lattice_vertices(seed: int, axis: int, level: int) -> No
     low=st.tuples(st.floats(-1.0, 0.2), st.floats(-1.0, 0.2), st.floats(-1.0, 0.2)),
     size=st.floats(0.3, 2.0),
 )
+# found by CI: two cut points coincide at a corner of the box, and earcut leaves a zero-area gap
+@example(seed=8925, low=(0.19999999999999998, 0.19999999999999998, 0.19921875), size=0.3)
 def test_random_boxes_carve_closed_columns(
     seed: int, low: tuple[float, float, float], size: float
 ) -> None:
@@ -120,3 +122,79 @@ def test_random_boxes_carve_closed_columns(
         slack = 1e-9 * bounds.diagonal + 1e-12
         assert (inside.vertices >= lo - slack).all()
         assert (inside.vertices <= lo + size + slack).all()
+
+
+#: The cap loop of the CI case above, in the plane's frame: a notch on the right (so earcut runs)
+#: and three cut points at the lower right corner, two of them identical.
+_CORNER_LOOP = np.array(
+    [
+        (0.17711711560800208, 0.07193006761960069),
+        (0.17978487233072415, 0.09549372206068235),
+        (0.18319379457257, 0.12560391353324346),
+        (0.07363410729313802, 0.12560391353324346),
+        (0.06438246550419474, 0.12560391353324346),
+        (0.03006326985680785, 0.12560391353324346),
+        (0.02567265999773699, 0.12560391353324346),
+        (0.009398951924954768, 0.12560391353324346),
+        (-0.024840074250906397, 0.12560391353324346),
+        (-0.026181887512973012, 0.12560391353324346),
+        (-0.05884455939829614, 0.12560391353324346),
+        (-0.09238249356678882, 0.12560391353324346),
+        (-0.09992883009370593, 0.12560391353324346),
+        (-0.10549052459092842, 0.12560391353324346),
+        (-0.10549052459092842, 0.11445302629131249),
+        (-0.10549052459092842, 0.11034690076540049),
+        (-0.10549052459092842, 0.09981995786481934),
+        (-0.10549052459092839, 0.09297600610274753),
+        (-0.10549052459092839, 0.09254987561342953),
+        (-0.10549052459092839, 0.05534514563254911),
+        (-0.10549052459092842, 0.055238643334633186),
+        (-0.10549052459092839, 0.041831401244495026),
+        (-0.10549052459092839, 0.041466041752601324),
+        (-0.10549052459092839, -0.013703682285388208),
+        (-0.10549052459092839, -0.014452682819490803),
+        (-0.10549052459092839, -0.029754324884470273),
+        (-0.10549052459092839, -0.04033899461927276),
+        (-0.10549052459092842, -0.07140942907066672),
+        (-0.10549052459092828, -0.07726930355115819),
+        (-0.10549052459092828, -0.08674339098240036),
+        (-0.10549052459092845, -0.11609000027206678),
+        (-0.10549052459092845, -0.17439608646675656),
+        (-0.086137017185515, -0.17439608646675656),
+        (-0.015294315091639421, -0.17439608646675656),
+        (-0.015046970234681434, -0.17439608646675656),
+        (0.050612171912914394, -0.17439608646675656),
+        (0.07990009047747254, -0.17439608646675656),
+        (0.18765028722013732, -0.17439608646675656),
+        (0.1945094754090716, -0.17439608646675656),
+        (0.1945094754090716, -0.17439608646675653),
+        (0.1945094754090716, -0.17439608646675653),
+        (0.1945094754090716, -0.16994499301517615),
+        (0.1945094754090716, -0.16952508928749116),
+        (0.1945094754090716, 0.0699775995457344),
+        (0.1945094754090716, 0.08451740522822854)
+,
+    ]
+)
+
+
+def test_cap_closes_a_loop_with_coincident_corner_points() -> None:
+    """Earcut drops one of the coincident points and leaves a zero-area gap between the loop
+    and its triangles; the cap still uses every loop edge once and covers the loop's area."""
+    from geobrep.plugins.clip._caps import _triangulate_polygon, loop_areas
+
+    ring = _CORNER_LOOP
+    n = len(ring)
+    offsets = np.array([0, n])
+    triangles = _triangulate_polygon(ring, np.arange(n), offsets, [0], "test")
+    edges = {
+        (int(t[k]), int(t[(k + 1) % 3])) for t in triangles.tolist() for k in range(3)
+    }
+    assert len(edges) == 3 * len(triangles)
+    loop = {(i, (i + 1) % n) for i in range(n)}
+    assert loop <= edges
+    assert all((b, a) in edges for a, b in edges - loop)
+    xy = ring[triangles]
+    ab, ac = xy[:, 1] - xy[:, 0], xy[:, 2] - xy[:, 0]
+    covered = 0.5 * (ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0]).sum()
+    assert covered == pytest.approx(loop_areas(ring, np.arange(n), offsets)[0], rel=1e-12)
