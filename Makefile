@@ -10,7 +10,7 @@ STAMPS := $(VENV)/.geobrep-stamps
 EXAMPLE_PLUGIN := docs/examples/geobrep-example-plugin
 PIP_QUIET := --quiet --disable-pip-version-check
 
-.PHONY: demo test test-newest test-min lint typecheck pytest bench fuzz schemas docs-tables sysdeps clean help geoh5-check
+.PHONY: demo test test-newest test-min lint typecheck pytest bench fuzz fuzz-properties schemas docs-tables sysdeps clean help geoh5-check
 
 help:
 	@echo "make demo   - run the demo on the built-in sample model (writes demo-output/)"
@@ -18,6 +18,7 @@ help:
 	@echo "make test-min - the suite on the lowest versions pyproject.toml allows (.venv-min)"
 	@echo "make bench  - benchmarks (not part of make test)"
 	@echo "make fuzz   - 25,000 mutated files through every reader (not part of make test)"
+	@echo "make fuzz-properties - the property tests with fresh random examples (not part of make test)"
 	@echo "make geoh5-check - cross-check the geoh5 adapter with geoh5py in a venv of its own"
 
 $(PY):
@@ -149,6 +150,11 @@ bench: $(STAMPS)/test
 FUZZ_CASES ?= 25000
 fuzz: $(STAMPS)/test
 	$(PY) benchmarks/fuzz.py --cases $(FUZZ_CASES) --timeout 10
+
+# The property tests with fresh random examples (make test draws the same ones every run):
+# GEOBREP_EXAMPLES per test, default 2000; a failure prints the @reproduce_failure to keep.
+fuzz-properties: $(STAMPS)/test
+	$(PY) -m pytest tests -q -p no:cacheprovider -m hypothesis --hypothesis-profile geobrep-explore
 
 clean:
 	rm -rf build dist *.egg-info .mypy_cache .ruff_cache .pytest_cache demo-output

@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 
 import pytest
@@ -17,13 +18,25 @@ from shapes import TETRA_FACES, TETRA_VERTICES, make_cube
 import geobrep
 from geobrep import Scene, Surface
 
+# The suite's property tests draw the same examples on every machine (``derandomize``), so a
+# clean-clone run reproduces exactly what passed here; ``make fuzz-properties`` explores with fresh
+# random examples (``geobrep-explore``, GEOBREP_EXAMPLES per test) and hypothesis prints the
+# ``@reproduce_failure`` line of anything it finds, to be kept as an ``@example``.
 settings.register_profile(
     "geobrep",
     deadline=None,
     max_examples=50,
+    derandomize=True,
+    database=None,
     suppress_health_check=[HealthCheck.too_slow],
 )
 settings.register_profile("geobrep-thorough", deadline=None, max_examples=500)
+settings.register_profile(
+    "geobrep-explore",
+    deadline=None,
+    max_examples=int(os.environ.get("GEOBREP_EXAMPLES", "2000")),
+    suppress_health_check=[HealthCheck.too_slow],
+)
 settings.load_profile("geobrep")
 
 

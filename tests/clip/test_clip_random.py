@@ -172,8 +172,7 @@ _CORNER_LOOP = np.array(
         (0.1945094754090716, -0.16994499301517615),
         (0.1945094754090716, -0.16952508928749116),
         (0.1945094754090716, 0.0699775995457344),
-        (0.1945094754090716, 0.08451740522822854)
-,
+        (0.1945094754090716, 0.08451740522822854),
     ]
 )
 
@@ -187,9 +186,7 @@ def test_cap_closes_a_loop_with_coincident_corner_points() -> None:
     n = len(ring)
     offsets = np.array([0, n])
     triangles = _triangulate_polygon(ring, np.arange(n), offsets, [0], "test")
-    edges = {
-        (int(t[k]), int(t[(k + 1) % 3])) for t in triangles.tolist() for k in range(3)
-    }
+    edges = {(int(t[k]), int(t[(k + 1) % 3])) for t in triangles.tolist() for k in range(3)}
     assert len(edges) == 3 * len(triangles)
     loop = {(i, (i + 1) % n) for i in range(n)}
     assert loop <= edges
