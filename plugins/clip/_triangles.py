@@ -5,7 +5,8 @@ entirely on one side (corners on the plane allowed) are kept or dropped whole; o
 with corners strictly on both sides (about √F of them for a plane through a mesh of F triangles)
 are split. Each cut edge gets one new vertex, shared by the triangles on both sides of it, so the
 result has no cracks and no duplicate vertices; a triangle with a corner on the plane is split
-through that corner.
+through that corner. Crossing points closer than the tolerance (two edges of a sliver) are one
+vertex, and the pieces that collapse with them are dropped.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.geometry import mesh
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.plugins.clip._sides import (
     NEGATIVE_BIT,
@@ -133,7 +135,10 @@ def cut_triangles(
     points, edge_a, edge_b, edge_t = crossing_points(
         vertices, distances, starts[first], ends[first]
     )
-    new_id = inverse.reshape(-1).astype(np.int64) + n
+    points, edge_a, edge_b, edge_t, point_of = _weld_crossings(
+        points, edge_a, edge_b, edge_t, tolerance
+    )
+    new_id = point_of[inverse.reshape(-1)] + n
     k = lone.shape[0]
     p01, p02, p12 = new_id[:k], new_id[k : 2 * k], new_id[2 * k :]
 
@@ -155,6 +160,14 @@ def cut_triangles(
         np.int64, copy=False
     )
     del unique_keys
+    if point_of.shape[0] != points.shape[0]:
+        # welded crossings: the pieces of a sliver that collapse to a point or an edge go
+        real = (
+            (pieces[:, 0] != pieces[:, 1])
+            & (pieces[:, 1] != pieces[:, 2])
+            & (pieces[:, 2] != pieces[:, 0])
+        )
+        pieces, piece_side, piece_source = pieces[real], piece_side[real], piece_source[real]
     return TriangleCut(
         vertices=vertices,
         triangles=triangles,
@@ -168,6 +181,26 @@ def cut_triangles(
         piece_side=piece_side,
         piece_source=piece_source,
     )
+
+
+def _weld_crossings(
+    points: FloatArray, edge_a: IntArray, edge_b: IntArray, edge_t: FloatArray, tolerance: float
+) -> tuple[FloatArray, IntArray, IntArray, FloatArray, IntArray]:
+    """Crossing points within ``tolerance`` of each other made one (the lowest-numbered).
+
+    Two edges of a sliver triangle can cross the plane at one place; left as two points they
+    give the cut's boundary a zero-length edge that no cap can close. Returns the welded points
+    with the edge each keeps, and ``point_of`` (one entry per crossing) mapping onto them.
+    """
+    identity = np.arange(points.shape[0], dtype=np.int64)
+    if points.shape[0] < 2:
+        return points, edge_a, edge_b, edge_t, identity
+    merged, point_of = mesh.merge_close_vertices(points, tolerance)
+    if merged.shape[0] == points.shape[0]:
+        return points, edge_a, edge_b, edge_t, identity
+    keeper = np.full(merged.shape[0], points.shape[0], dtype=np.int64)
+    np.minimum.at(keeper, point_of, identity)
+    return points[keeper], edge_a[keeper], edge_b[keeper], edge_t[keeper], point_of
 
 
 def _in_plane_selection(
