@@ -1,5 +1,5 @@
 """GOCAD formats: TSurf (.ts), PLine (.pl), VSet (.vs), TSolid (.so), Model3d (.ml), groups,
-Voxet (.vo, with its property files) and Well (.wl).
+Voxet (.vo) and SGrid (.sg), with their side files, and Well (.wl).
 
 One format, ``gocad``, covers the family: the reader recognises each object by its
 ``GOCAD <Type>`` line (so a .ts holding a PLine still reads), the writer picks the object type
@@ -18,7 +18,7 @@ from geobrep.model.scene import Scene
 __all__ = ["EXTENSIONS", "geobrep_register_formats", "looks_like_gocad"]
 
 #: File extensions of the GOCAD ASCII family.
-EXTENSIONS = (".ts", ".pl", ".vs", ".so", ".ml", ".gp", ".vo", ".wl")
+EXTENSIONS = (".ts", ".pl", ".vs", ".so", ".ml", ".gp", ".vo", ".sg", ".wl")
 
 
 def looks_like_gocad(head: bytes) -> bool:
@@ -61,16 +61,19 @@ _HELD = {
     ".ml": ("Model3d", frozenset({"Surface", "Block"})),
     ".gp": ("group", frozenset({"Surface", "PolyLine", "PointSet", "TetMesh"})),
     ".vo": ("Voxet", frozenset({"RegularGrid"})),
+    ".sg": ("SGrid", frozenset({"StructuredGrid"})),
     ".wl": ("Well", frozenset({"Well"})),
 }
 
 
-_FAMILY = frozenset({"Surface", "PolyLine", "PointSet", "TetMesh", "Block", "RegularGrid", "Well"})
+_FAMILY = frozenset(
+    {"Surface", "PolyLine", "PointSet", "TetMesh", "Block", "RegularGrid", "StructuredGrid", "Well"}
+)
 
 
 def _grid_losses(scene: Scene, path: Path) -> list[str]:
     """What a Voxet or Well file cannot hold of the one entity it keeps."""
-    from geobrep.model.entities import RegularGrid, Well
+    from geobrep.model.entities import RegularGrid, StructuredGrid, Well
 
     suffix = path.suffix.lower()
     lost: list[str] = []
@@ -80,6 +83,12 @@ def _grid_losses(scene: Scene, path: Path) -> list[str]:
                 lost.append(f"{entity.label}: cell data (a Voxet holds node values)")
             elif entity.cell_data:
                 lost.append(f"{entity.label}: cells (cell data are written at the cell centres)")
+            break
+        if suffix == ".sg" and isinstance(entity, StructuredGrid):
+            if entity.points is None:
+                lost.append(f"{entity.label}: a corner-point grid (an SGrid holds node points)")
+            elif entity.actnum is not None and not entity.actnum.all():
+                lost.append(f"{entity.label}: inactive cells (actnum)")
             break
         if suffix == ".wl" and isinstance(entity, Well):
             if any(m.surface for m in entity.markers):
@@ -97,7 +106,7 @@ def _losses(scene: Scene, path: Path) -> list[str]:
     object_type, held = _HELD.get(path.suffix.lower(), ("", frozenset()))
     if not held:
         return []
-    grid_lost = _grid_losses(scene, path) if object_type in ("Voxet", "Well") else []
+    grid_lost = _grid_losses(scene, path) if object_type in ("Voxet", "SGrid", "Well") else []
     dropped: dict[str, int] = {}
     for entity in scene.entities:
         if entity.type in held or entity.type not in _FAMILY:
@@ -116,13 +125,13 @@ def _losses(scene: Scene, path: Path) -> list[str]:
 
 @hookimpl
 def geobrep_register_formats(registry: FormatRegistry) -> None:
-    """Register the ``gocad`` format (.ts .pl .vs .so .ml .gp .vo .wl)."""
+    """Register the ``gocad`` format (.ts .pl .vs .so .ml .gp .vo .sg .wl)."""
     from geobrep.adapters.gocad.options import GocadOptions
 
     registry.add(
         FormatSpec(
             name="gocad",
-            description="GOCAD: TSurf, PLine, VSet, TSolid, Model3d, groups, Voxet and Well",
+            description="GOCAD: TSurf, PLine, VSet, TSolid, Model3d, groups, Voxet, SGrid and Well",
             extensions=EXTENSIONS,
             reader=_read,
             writer=_write,

@@ -1,4 +1,5 @@
-"""The GOCAD objects read line by line: Voxet (.vo) and Well (.wl), to and from scenes."""
+"""The GOCAD objects read line by line: Voxet (.vo), SGrid (.sg) and Well (.wl), to and from
+scenes."""
 
 from __future__ import annotations
 
@@ -7,11 +8,13 @@ from pathlib import Path
 from geobrep.adapters.gocad._lexer import split_tokens
 from geobrep.adapters.gocad._objects import report
 from geobrep.adapters.gocad._reader import crs_from_block
+from geobrep.adapters.gocad._sgrid import read_sgrid
+from geobrep.adapters.gocad._sgrid_writer import write_sgrid
 from geobrep.adapters.gocad._voxet import read_voxet
 from geobrep.adapters.gocad._voxet_writer import write_voxet
 from geobrep.adapters.gocad._well import read_well, well_text
 from geobrep.errors import FormatError
-from geobrep.model.entities import Entity, RegularGrid, Well
+from geobrep.model.entities import Entity, RegularGrid, StructuredGrid, Well
 from geobrep.model.scene import Scene
 
 __all__ = ["GRID_OBJECTS", "object_type_of", "read_grid_object", "write_grid_object"]
@@ -19,6 +22,7 @@ __all__ = ["GRID_OBJECTS", "object_type_of", "read_grid_object", "write_grid_obj
 #: Object type → the extension it is written with and the entity type it holds.
 GRID_OBJECTS: dict[str, tuple[str, type[Entity]]] = {
     "Voxet": (".vo", RegularGrid),
+    "SGrid": (".sg", StructuredGrid),
     "Well": (".wl", Well),
 }
 _BY_SUFFIX = {suffix: name for name, (suffix, _) in GRID_OBJECTS.items()}
@@ -32,14 +36,16 @@ def object_type_of(path: Path) -> str | None:
         tokens = split_tokens(text)
         if tokens:
             kind = tokens[1] if len(tokens) > 1 and tokens[0].upper() == "GOCAD" else ""
+            if kind == "SGrid" and path.suffix.lower() != ".sg":
+                return None  # an SGrid header before other objects (sgrid_tsurf.ts)
             return kind if kind in GRID_OBJECTS else None
     return None
 
 
 def read_grid_object(path: Path, object_type: str) -> Scene:
-    """A scene holding the object of a Voxet or Well file."""
-    if object_type == "Voxet":
-        grid, keyed = read_voxet(path)
+    """A scene holding the object of a Voxet, SGrid or Well file."""
+    if object_type in ("Voxet", "SGrid"):
+        grid, keyed = read_voxet(path) if object_type == "Voxet" else read_sgrid(path)
         crs = crs_from_block(keyed.crs) if keyed.crs is not None else None
         return Scene(entities=[grid.replace(id=0)], crs=crs, name=path.stem)
     well, block = read_well(path)
@@ -67,6 +73,8 @@ def write_grid_object(scene: Scene, path: Path, object_type: str, ascii_data: bo
     entity = chosen[0]
     if isinstance(entity, RegularGrid):
         write_voxet(entity, scene.crs, path, ascii_data)
+    elif isinstance(entity, StructuredGrid):
+        write_sgrid(entity, scene.crs, path)
     else:
         assert isinstance(entity, Well)
         path.write_text(well_text(entity, scene.crs), encoding="utf-8")

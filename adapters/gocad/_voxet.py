@@ -30,7 +30,10 @@ from geobrep.model.properties import Property
 __all__ = [
     "PropertyFile",
     "VoxetAxes",
+    "mapped_array",
     "property_dtype",
+    "property_lines",
+    "property_meta",
     "read_voxet",
     "side_file",
     "voxet_grid",
@@ -76,7 +79,7 @@ def property_dtype(prop: PropertyFile, where: KeyedLine | None, path: Path) -> n
     raise FormatError(f"{message} is not a supported value type", path, prop.line or None)
 
 
-def _property_lines(keyed: KeyedFile) -> dict[int, PropertyFile]:
+def property_lines(keyed: KeyedFile) -> dict[int, PropertyFile]:
     props: dict[int, PropertyFile] = {}
     for line in keyed.lines:
         keyword = line.keyword
@@ -169,27 +172,37 @@ def side_file(path: Path, name: str, what: str) -> Path:
     return path.parent / name
 
 
+def mapped_array(
+    path: Path, name: str, what: str, dtype: np.dtype[Any], offset: int, count: int
+) -> NDArray[Any]:
+    """``count`` values of ``dtype`` from byte ``offset`` of the side file ``name`` beside the
+    header ``path``, memory-mapped and copied in native byte order; a FormatError naming the
+    file when it is missing or too short."""
+    side = side_file(path, name, what)
+    try:
+        size = side.stat().st_size
+    except OSError:
+        raise FormatError(f"{what}: its file {str(side)!r} is missing", path) from None
+    need = offset + count * dtype.itemsize
+    if size < need:
+        raise FormatError(
+            f"{what}: its file {str(side)!r} has {size} bytes, "
+            f"{count} values of {dtype.itemsize} bytes from byte {offset} need {need}",
+            path,
+        )
+    if count == 0:
+        return np.zeros(0, dtype=dtype.newbyteorder("="))
+    mapped = np.memmap(side, dtype=dtype, mode="r", offset=offset, shape=(count,))
+    return np.ascontiguousarray(mapped, dtype=dtype.newbyteorder("="))
+
+
 def _binary(prop: PropertyFile, count: int, path: Path) -> NDArray[Any]:
     """The values of a raw property file beside the header (errors name both files)."""
     if prop.file is None:
         raise FormatError(f"property {prop.name!r} has no PROP_FILE", path, prop.line or None)
-    side = side_file(path, prop.file, f"property {prop.name!r}: PROP_FILE")
     dtype = property_dtype(prop, None, path)
-    try:
-        size = side.stat().st_size
-    except OSError:
-        raise FormatError(
-            f"property {prop.name!r}: its file {str(side)!r} is missing", path
-        ) from None
-    need = prop.offset + count * dtype.itemsize
-    if size < need:
-        raise FormatError(
-            f"property {prop.name!r}: its file {str(side)!r} has {size} bytes, "
-            f"{count} values of {dtype.itemsize} bytes need {need}",
-            path,
-        )
-    mapped = np.memmap(side, dtype=dtype, mode="r", offset=prop.offset, shape=(count,))
-    return np.ascontiguousarray(mapped, dtype=dtype.newbyteorder("="))
+    what = f"property {prop.name!r}: PROP_FILE"
+    return mapped_array(path, prop.file, what, dtype, prop.offset, count)
 
 
 def _ascii_table(
@@ -234,7 +247,7 @@ def read_voxet(path: Path) -> tuple[RegularGrid, KeyedFile]:
     axes = _axes(keyed)
     z_sign = -1.0 if (keyed.crs or {}).get("ZPOSITIVE") == "Depth" else 1.0
     grid = voxet_grid(axes, z_sign, path, keyed.name)
-    props = _property_lines(keyed)
+    props = property_lines(keyed)
     counts = axes.counts or (1, 1, 1)
     total = int(np.prod(counts))
     ascii_line = next((ln for ln in keyed.lines if ln.keyword == "ASCII_DATA_FILE"), None)
@@ -247,7 +260,7 @@ def read_voxet(path: Path) -> tuple[RegularGrid, KeyedFile]:
         values = {p.name: _binary(p, total, path) for p in ordered}
     data = {
         p.name: Property(
-            values=values[p.name], unit=p.unit, no_data_value=p.no_data, metadata=_meta(p)
+            values=values[p.name], unit=p.unit, no_data_value=p.no_data, metadata=property_meta(p)
         )
         for p in ordered
     }
@@ -255,7 +268,7 @@ def read_voxet(path: Path) -> tuple[RegularGrid, KeyedFile]:
     return grid.replace(point_data=data, metadata=metadata), keyed
 
 
-def _meta(prop: PropertyFile) -> dict[str, Any]:
+def property_meta(prop: PropertyFile) -> dict[str, Any]:
     gocad: dict[str, Any] = {}
     if prop.kind:
         gocad["kind"] = prop.kind

@@ -25,9 +25,9 @@ from geobrep.model.entities import RegularGrid
 from geobrep.model.properties import Property
 from geobrep.ops.io import atomic_write
 
-__all__ = ["final_name", "voxet_text", "write_voxet"]
+__all__ = ["SAFE_NAME", "dtype_words", "final_name", "voxet_text", "write_voxet"]
 
-_SAFE = re.compile(r"[^A-Za-z0-9_.-]+")
+SAFE_NAME = re.compile(r"[^A-Za-z0-9_.-]+")
 
 
 def final_name(path: Path) -> Path:
@@ -50,7 +50,7 @@ def _layout(grid: RegularGrid) -> tuple[dict[str, Property], NDArray[np.float64]
     return dict(grid.cell_data), centre, grid.counts
 
 
-def _dtype_words(values: NDArray[Any], name: str) -> tuple[np.dtype[Any], list[str]]:
+def dtype_words(values: NDArray[Any], name: str) -> tuple[np.dtype[Any], list[str]]:
     kind, size = values.dtype.kind, values.dtype.itemsize
     if values.ndim != 1:
         raise FormatError(f"property {name!r}: a Voxet property has one value per node")
@@ -95,7 +95,7 @@ def voxet_text(
     arrays: dict[str, NDArray[Any]] = {}
     for number, (name, prop) in enumerate(props.items(), start=1):
         values = np.asarray(prop.values)
-        dtype, words = _dtype_words(values, name)
+        dtype, words = dtype_words(values, name)
         lines.append(f"PROPERTY {number} {quote_rest(name)}")
         section = prop.metadata.get("gocad")
         kind = section.get("kind") if isinstance(section, dict) else None
@@ -145,7 +145,7 @@ def write_voxet(grid: RegularGrid, crs: CRS | None, path: Path, ascii_data: bool
             temporary.write_text(_ascii_table(arrays, counts), encoding="utf-8")
         path.write_text(text, encoding="utf-8")
         return
-    files = {name: f"{final.stem}__{_SAFE.sub('_', name)}@@" for name in props}
+    files = {name: f"{final.stem}__{SAFE_NAME.sub('_', name)}@@" for name in props}
     if len(set(files.values())) != len(files):
         files = {name: f"{final.stem}__{i}@@" for i, name in enumerate(props, start=1)}
     text, arrays = voxet_text(grid, crs, files)

@@ -29,8 +29,8 @@ class GocadOptions(BaseModel):
     Model3d's corners and arcs are rebuilt (default: 1e-8 of the bounding-box diagonal)."""
     object_type: str | None = None
     """Writing: ``TSurf``, ``PLine``, ``VSet``, ``TSolid``, ``Model3d``,
-    ``HeterogeneousGroup``, ``Voxet`` or ``Well``; default: from the extension
-    (.ts .pl .vs .so .ml .gp .vo .wl)."""
+    ``HeterogeneousGroup``, ``Voxet``, ``SGrid`` or ``Well``; default: from the extension
+    (.ts .pl .vs .so .ml .gp .vo .sg .wl)."""
 
     voxet_ascii: bool = False
     """Writing a Voxet: its properties in one ``ASCII_DATA_FILE`` table of ``I J K value...``

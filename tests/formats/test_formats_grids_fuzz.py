@@ -1,5 +1,6 @@
 """Mutated grid and well files (generated: a rotated Voxet with a big-endian float property and
-no-data values, a deviated well with markers, a faulted corner-point grid, a deviation table)
+no-data values, a curvilinear SGrid with point, cell and flag files, a deviated well with
+markers, a faulted corner-point grid, a deviation table)
 read as a scene or fail with the reader's own FormatError, never another exception or
 ``geobrep.read``'s catch-all ("<format> reader failed: ...")."""
 
@@ -15,7 +16,7 @@ from hypothesis import strategies as st
 from test_formats_grdecl import faulted_grid
 
 import geobrep
-from geobrep import Property, RegularGrid, Scene, Well, WellMarker, WellZone
+from geobrep import Property, RegularGrid, Scene, StructuredGrid, Well, WellMarker, WellZone
 from geobrep.geometry.trajectory import minimum_curvature
 
 
@@ -48,6 +49,21 @@ def _well() -> Well:
     )
 
 
+def _sgrid() -> StructuredGrid:
+    k, j, i = np.meshgrid(np.arange(3), np.arange(3), np.arange(4), indexing="ij")
+    points = np.stack([i * 10.0 + j, j * 20.0, k * 5.0 + 0.5 * i], axis=-1).reshape(-1, 3)
+    return StructuredGrid(
+        name="s",
+        counts=(3, 2, 2),
+        points=points,
+        point_data={
+            "phi": Property(values=np.linspace(0, 1, 36, dtype=np.float32), no_data_value=-1.0),
+            "sgrid_flags": Property(values=np.arange(36, dtype=np.int32) % 3),
+        },
+        cell_data={"facies": Property(values=np.arange(12, dtype=np.int16))},
+    )
+
+
 def _files(folder: Path) -> dict[str, list[Path]]:
     """Each generated file and its side files (mutated too)."""
     with warnings.catch_warnings():
@@ -56,7 +72,15 @@ def _files(folder: Path) -> dict[str, list[Path]]:
         wl = geobrep.write(Scene(entities=[_well()]), folder / "w.wl")
         grdecl = geobrep.write(faulted_grid(), folder / "g.grdecl")
         dev = geobrep.write(_well().replace(markers=(), zones=()), folder / "w.dev")
-    return {"v.vo": [vo, folder / "v__p@@"], "w.wl": [wl], "g.grdecl": [grdecl], "w.dev": [dev]}
+        sg = geobrep.write(_sgrid(), folder / "s.sg")
+    sides = sorted(folder.glob("s__*@@"))
+    return {
+        "v.vo": [vo, folder / "v__p@@"],
+        "s.sg": [sg, *sides],
+        "w.wl": [wl],
+        "g.grdecl": [grdecl],
+        "w.dev": [dev],
+    }
 
 
 @pytest.fixture(scope="module")
@@ -111,8 +135,8 @@ def _read_or_error(path: Path) -> geobrep.FormatError | None:
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
 @given(
-    st.sampled_from(["v.vo", "w.wl", "g.grdecl", "w.dev"]),
-    st.integers(0, 1),
+    st.sampled_from(["v.vo", "s.sg", "w.wl", "g.grdecl", "w.dev"]),
+    st.integers(0, 4),
     st.lists(mutation, min_size=1, max_size=4),
 )
 def test_a_mutated_grid_or_well_reads_or_fails_with_a_format_error(
@@ -124,7 +148,7 @@ def test_a_mutated_grid_or_well_reads_or_fails_with_a_format_error(
 ) -> None:
     folder = tmp_path_factory.mktemp("mutated")
     files = originals[key]
-    target = which % len(files)  # the header, or the Voxet's binary property file
+    target = which % len(files)  # the header, or one of its binary side files
     for index, (name, data) in enumerate(files):
         (folder / name).write_bytes(_mutate(data, steps) if index == target else data)
     error = _read_or_error(folder / files[0][0])
