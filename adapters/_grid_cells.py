@@ -120,9 +120,11 @@ def cell_values(entity: Any) -> PropertyMap:
     return found
 
 
-def grid_entity(grid: Grid, name: str, cells: PropertyMap, metadata: dict[str, Any]) -> Entity:
+def grid_entity(
+    grid: Grid, name: str, cells: PropertyMap, metadata: dict[str, Any], **fields: Any
+) -> Entity:
     """A :class:`RegularGrid` when the cells along each axis have one size, else the point
-    set of the cell centres standing for ``grid``."""
+    set of the cell centres standing for ``grid``; ``fields`` are more entity fields (id)."""
     if all(len(s) and bool(np.all(s == s[0])) for s in grid.sizes):
         u, v, w = (np.asarray(a) * s[0] for a, s in zip(grid.axes, grid.sizes, strict=True))
         return RegularGrid(
@@ -134,5 +136,6 @@ def grid_entity(grid: Grid, name: str, cells: PropertyMap, metadata: dict[str, A
             cell_data=cells,
             name=name,
             metadata=metadata,
+            **fields,
         )
-    return grid.point_set(name, point_data=cells, metadata=metadata)
+    return grid.point_set(name, point_data=cells, metadata=metadata, **fields)

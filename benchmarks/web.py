@@ -13,7 +13,7 @@ direct calls do what a user needs for the same file content and no more:
 
 Prints best and median of N interleaved runs and their ratios (target: at most 1.10).
 
-    .venv/bin/python benchmarks/web.py [--triangles 1000000] [--repeat 3]
+    .venv/bin/python benchmarks/web.py [--triangles 1000000] [--repeat 5]
 """
 
 from __future__ import annotations
@@ -196,7 +196,7 @@ def _run(
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--triangles", type=int, default=1_000_000)
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args()
     surface = make_surface(args.triangles)
     scene = Scene(entities=[surface], crs=CRS(epsg=32631))

@@ -108,9 +108,8 @@ def _write_data(root: h5py.Group, obj: h5py.Group, props: PropertyMap, associati
 
 
 def _vertices(points: NDArray[np.float64]) -> NDArray[Any]:
-    rows = np.empty(len(points), dtype=_XYZ)
-    rows["x"], rows["y"], rows["z"] = points[:, 0], points[:, 1], points[:, 2]
-    return rows
+    """``(N, 3)`` float64 points as geoh5's x, y, z records (a view when they are C-ordered)."""
+    return np.ascontiguousarray(points, dtype="<f8").view(_XYZ).reshape(-1)
 
 
 def _rotation(grid: Grid) -> float:
@@ -225,12 +224,14 @@ def _read_data(obj: h5py.Group, association: str, n: int, order: Any = None) -> 
 
 def _xyz(obj: h5py.Group) -> NDArray[np.float64]:
     rows = obj["Vertices"][()]
+    if rows.dtype == _XYZ:  # geobrep's and geoh5py's records: the floats as they lie
+        return rows.view("<f8").reshape(-1, 3).astype(np.float64, copy=False)
     if rows.dtype.names:
         return np.column_stack([rows[k] for k in ("x", "y", "z")]).astype(np.float64)
     return np.asarray(rows, dtype=np.float64).reshape(-1, 3)
 
 
-def _block_model(obj: h5py.Group, name: str) -> Entity:
+def _block_model(obj: h5py.Group, name: str, ident: int) -> Entity:
     origin = obj.attrs["Origin"]
     corner = np.array([origin["x"], origin["y"], origin["z"]], dtype=np.float64)
     delimiters = [np.asarray(obj[f"{a} cell delimiters"][()], dtype=np.float64) for a in "UVZ"]
@@ -243,20 +244,23 @@ def _block_model(obj: h5py.Group, name: str) -> Entity:
     corner = corner + start @ np.asarray(axes) if start.any() else corner
     grid = Grid(origin=triple(corner), sizes=tuple(np.diff(d) for d in delimiters), axes=axes)  # type: ignore[arg-type]
     order = np.argsort(_geoh5_order(grid.shape))
-    return grid_entity(grid, name, _read_data(obj, "Cell", grid.n_cells, order), {})
+    cells = _read_data(obj, "Cell", grid.n_cells, order)
+    return grid_entity(grid, name, cells, {}, id=ident)
 
 
-def _object(obj: h5py.Group) -> Entity | None:
+def _object(obj: h5py.Group, ident: int) -> Entity | None:
+    """The entity of ``obj`` with id ``ident`` (given here: a Scene giving ids would validate
+    each entity again), or None for a type geobrep does not read."""
     kind = _BY_TYPE.get(_text(obj["Type"].attrs.get("ID", "")).lower())
     name = _text(obj.attrs.get("Name", ""))
     if kind == "Block model":
-        return _block_model(obj, name)
+        return _block_model(obj, name, ident)
     if kind is None or "Vertices" not in obj:
         return None
     vertices = _xyz(obj)
     points = _read_data(obj, "Vertex", len(vertices))
     if kind == "Points":
-        return PointSet(vertices=vertices, name=name, point_data=points)
+        return PointSet(vertices=vertices, name=name, point_data=points, id=ident)
     cells = (
         np.asarray(obj["Cells"][()], dtype=np.int64)
         if "Cells" in obj
@@ -265,10 +269,15 @@ def _object(obj: h5py.Group) -> Entity | None:
     cell_data = _read_data(obj, "Cell", len(cells))
     if kind == "Surface":
         return Surface(
-            vertices=vertices, faces=cells, name=name, point_data=points, cell_data=cell_data
+            vertices=vertices,
+            faces=cells,
+            name=name,
+            point_data=points,
+            cell_data=cell_data,
+            id=ident,
         )
     return chain_segments(
-        vertices, cells.reshape(-1, 2), cell_data, {"name": name, "point_data": points}
+        vertices, cells.reshape(-1, 2), cell_data, {"name": name, "point_data": points, "id": ident}
     )
 
 
@@ -283,7 +292,7 @@ def read_geoh5(path: Path) -> Scene:
             entities, skipped = [], []
             for ident, obj in root.get("Objects", {}).items():
                 try:
-                    entity = _object(obj)
+                    entity = _object(obj, len(entities))
                 except GeobrepError as exc:
                     raise FormatError(f"object {ident}: {exc}", path) from exc
                 if entity is None:

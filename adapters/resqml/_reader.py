@@ -125,19 +125,22 @@ def _crs(crs: Any) -> CRS | None:
 
 
 def _world(model: Any, crs_uuid: Any, points: NDArray[Any]) -> NDArray[np.float64]:
-    """Local CRS coordinates as world coordinates, z up."""
+    """Local CRS coordinates as world coordinates, z up (one new array at most: resqpy's
+    arrays are the model's, read for this scene only)."""
     import resqpy.crs as rqc
 
     crs = rqc.Crs(model, uuid=crs_uuid)
-    world = np.array(points, dtype=np.float64).reshape(-1, 3)
+    world = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     if crs.rotation:
         world = crs.local_to_global_array(world.copy(), global_z_inc_down=crs.z_inc_down)
     else:
         offset = np.array([crs.x_offset, crs.y_offset, crs.z_offset], dtype=np.float64)
         axes = np.flatnonzero(offset)  # adding a zero would turn -0.0 into 0.0
-        world[:, axes] += offset[axes]
+        if len(axes):
+            world = world.copy()
+            world[:, axes] += offset[axes]
     if crs.z_inc_down:
-        world[:, 2] = -world[:, 2]
+        world = world * np.array([1.0, 1.0, -1.0])
     return world
 
 
@@ -163,41 +166,37 @@ def _entity(model: Any, obj_type: str, uuid: Any) -> Entity:
     import resqpy.surface as rqs
 
     if obj_type == "TriangulatedSetRepresentation":
-        rep = rqs.Surface(model, uuid=uuid)
-        return _surface(model, rep)
+        return _surface(model, rqs.Surface(model, uuid=uuid))
     if obj_type == "PointSetRepresentation":
         rep = rqs.PointSet(model, uuid=uuid)
         vertices = _world(model, rep.crs_uuid, rep.full_array_ref())
-        return _finish(model, rep, PointSet(vertices=vertices), len(vertices), 0)
+        return _finish(model, rep, PointSet, {"vertices": vertices}, len(vertices), 0)
     if obj_type == "PolylineSetRepresentation":
         rep = rql.PolylineSet(model, uuid=uuid)
         counts = np.asarray(rep.count_perpol, dtype=np.int64)
         closed = np.asarray(rep.closed_array, dtype=bool)
-        coordinates = rep.coordinates
     else:
         rep = rql.Polyline(model, uuid=uuid)
         counts, closed = np.array([len(rep.coordinates)]), np.array([bool(rep.isclosed)])
-        coordinates = rep.coordinates
-    vertices = _world(model, rep.crs_uuid, coordinates)
-    line = PolyLine(
-        vertices=vertices,
-        indices=np.arange(len(vertices)),
-        part_offsets=np.concatenate([[0], np.cumsum(counts)]),
-        closed=closed,
-    )
-    return _finish(model, rep, line, len(vertices), line.n_cells)
+    vertices = _world(model, rep.crs_uuid, rep.coordinates)
+    line = {
+        "vertices": vertices,
+        "indices": np.arange(len(vertices)),
+        "part_offsets": np.concatenate([[0], np.cumsum(counts)]),
+        "closed": closed,
+    }
+    return _finish(model, rep, PolyLine, line, len(vertices), int(counts.sum() - (~closed).sum()))
 
 
 def _surface(model: Any, rep: Any) -> Entity:
     triangles, points = rep.triangles_and_points()
     vertices = _world(model, rep.crs_uuid, points)
-    labels = None
+    fields: dict[str, Any] = {"vertices": vertices, "faces": np.asarray(triangles, dtype=np.int64)}
     if rep.number_of_patches() > 1:
-        labels = np.asarray(rep.patch_indices_for_triangle_indices(np.arange(len(triangles))))
-    surface = Surface(
-        vertices=vertices, faces=np.asarray(triangles, dtype=np.int64), patch_labels=labels
-    )
-    return _finish(model, rep, surface, len(vertices), len(triangles))
+        fields["patch_labels"] = np.asarray(
+            rep.patch_indices_for_triangle_indices(np.arange(len(triangles)))
+        )
+    return _finish(model, rep, Surface, fields, len(vertices), len(triangles))
 
 
 def _properties(rep: Any, n_nodes: int, n_cells: int) -> tuple[dict[str, Any], dict[str, Any]]:
@@ -210,7 +209,7 @@ def _properties(rep: Any, n_nodes: int, n_cells: int) -> tuple[dict[str, Any], d
     for part in collection.parts():
         name = collection.citation_title_for_part(part)
         element = collection.indexable_for_part(part)
-        values = np.array(collection.cached_part_array_ref(part, masked=False))
+        values = np.asarray(collection.cached_part_array_ref(part, masked=False))
         unit = None if not collection.continuous_for_part(part) else collection.uom_for_part(part)
         unit = None if unit in (None, "Euc") else unit
         if element == "nodes" and len(values) == n_nodes:
@@ -220,22 +219,25 @@ def _properties(rep: Any, n_nodes: int, n_cells: int) -> tuple[dict[str, Any], d
     return nodes, cells
 
 
-def _finish(model: Any, rep: Any, entity: Entity, n_nodes: int, n_cells: int) -> Entity:
-    """``entity`` with the name, kind, properties and record of ``rep``."""
+def _finish(
+    model: Any, rep: Any, cls: type[Entity], fields: dict[str, Any], n_nodes: int, n_cells: int
+) -> Entity:
+    """The ``cls`` entity of ``fields`` with the name, kind, properties and record of ``rep``
+    (built and validated once)."""
     record = decode_record(rep.extra_metadata)
     nodes, cells = _properties(rep, n_nodes, n_cells)
-    changes: dict[str, Any] = {"name": rep.title or "", "kind": _kind(model, rep.root, record)}
+    fields.update(name=rep.title or "", kind=_kind(model, rep.root, record))
     patch = cells.pop(PATCH_PROPERTY, None)
-    if patch is not None and isinstance(entity, Surface):
-        changes["patch_labels"] = np.asarray(patch[0], dtype=np.int64)
+    if patch is not None and cls is Surface:
+        fields["patch_labels"] = np.asarray(patch[0], dtype=np.int64)
     if record is not None:
-        changes["id"] = record.get("id")
-        changes["metadata"] = record.get("metadata", {})
-        if isinstance(entity, Surface) and record.get("patch_names"):
-            changes["patch_names"] = tuple(record["patch_names"])
-    changes["point_data"] = properties_from(nodes, (record or {}).get("point_data"))
-    changes["cell_data"] = properties_from(cells, (record or {}).get("cell_data"))
-    return entity.replace(**changes)
+        fields["id"] = record.get("id")
+        fields["metadata"] = record.get("metadata", {})
+        if cls is Surface and record.get("patch_names"):
+            fields["patch_names"] = tuple(record["patch_names"])
+    fields["point_data"] = properties_from(nodes, (record or {}).get("point_data"))
+    fields["cell_data"] = properties_from(cells, (record or {}).get("cell_data"))
+    return cls(**fields)
 
 
 def _blocks(model: Any) -> list[Entity]:

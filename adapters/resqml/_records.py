@@ -57,7 +57,7 @@ def property_record(prop: Property) -> dict[str, Any]:
     return {
         "dtype": prop.dtype.str,
         "unit": prop.unit,
-        "no_data_value": prop.model_dump(mode="json")["no_data_value"],
+        "no_data_value": prop.model_dump(mode="json", include={"no_data_value"})["no_data_value"],
         "description": prop.description,
         "metadata": prop.metadata,
     }

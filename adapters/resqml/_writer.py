@@ -93,17 +93,18 @@ class _Frame:
         self.offset = np.zeros(3) if offset is None else np.asarray(offset, dtype=np.float64)
 
     def local(self, vertices: NDArray[np.float64], label: str) -> NDArray[np.float64]:
-        points = np.array(vertices, dtype=np.float64)
+        """The local coordinates of ``vertices`` (``vertices`` itself when nothing changes:
+        resqpy copies what it is given)."""
+        points = np.asarray(vertices, dtype=np.float64)
         if self.z_down:
-            points[:, 2] = -points[:, 2]
+            points = points * np.array([1.0, 1.0, -1.0])
         axes = np.flatnonzero(self.offset)  # a zero offset is not applied: -0.0 stays -0.0
         if not len(axes):
             return points
         local = points.copy()
         local[:, axes] -= self.offset[axes]
-        restored = local.copy()
-        restored[:, axes] += self.offset[axes]
-        if restored.tobytes() != points.tobytes():
+        restored = local[:, axes] + self.offset[axes]
+        if not np.array_equal(restored.view(np.uint64), points[:, axes].view(np.uint64)):
             raise OptionsError(
                 f"offset {tuple(self.offset.tolist())} would change coordinates of {label} "
                 "(choose an origin near the data, e.g. whole metres below its minimum)"
