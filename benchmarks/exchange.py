@@ -20,10 +20,10 @@ from __future__ import annotations
 import sys
 import tempfile
 import time
-from statistics import median
 import warnings
 from collections.abc import Callable
 from pathlib import Path
+from statistics import median
 from typing import Any
 
 import numpy as np
