@@ -20,12 +20,17 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+# formats_io.py lives beside this file; appended (benchmarks/inspect.py must not shadow the
+# standard module, so this folder is never first on sys.path).
+sys.path.append(str(Path(__file__).parent))
 from formats_io import make_surface, summary, timed
 
 from geobrep.model.crs import CRS
