@@ -223,7 +223,7 @@ def _read_data(obj: h5py.Group, association: str, n: int, order: Any = None) -> 
 
 
 def _xyz(obj: h5py.Group) -> NDArray[np.float64]:
-    rows = obj["Vertices"][()]
+    rows: NDArray[Any] = obj["Vertices"][()]
     if rows.dtype == _XYZ:  # geobrep's and geoh5py's records: the floats as they lie
         return rows.view("<f8").reshape(-1, 3).astype(np.float64, copy=False)
     if rows.dtype.names:
@@ -289,7 +289,8 @@ def read_geoh5(path: Path) -> Scene:
             if "GEOSCIENCE" not in store:
                 raise FormatError("not a geoh5 workspace (no GEOSCIENCE group)", path)
             root = store["GEOSCIENCE"]
-            entities, skipped = [], []
+            entities: list[Entity] = []
+            skipped: list[str] = []
             for ident, obj in root.get("Objects", {}).items():
                 try:
                     entity = _object(obj, len(entities))
