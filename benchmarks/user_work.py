@@ -32,7 +32,10 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 DATA = ROOT / "tests" / "data" / "gocad"
 BIN = Path(sys.executable).parent
-sys.path.insert(0, str(HERE))
+# benchmarks/inspect.py is named after the stdlib module: the folder (first on sys.path when this
+# script is run directly) goes last, so `import inspect` finds the standard one and `_inputs` ours.
+sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != HERE]
+sys.path.append(str(HERE))
 
 Times = list[float]
 
@@ -80,11 +83,18 @@ def calls(function: Callable[[], Any], repeat: int, warm_up: bool = True) -> Tim
     return times
 
 
+#: The environment of the measured commands: bytecode is written (the warm-up run caches the
+#: .pyc files an installed package has; PYTHONDONTWRITEBYTECODE would recompile every run).
+ENV = {key: value for key, value in os.environ.items() if key != "PYTHONDONTWRITEBYTECODE"}
+
+
 def whole_process(command: Sequence[str], repeat: int) -> Times:
     """Seconds of ``repeat`` runs of ``command`` after one warm-up run (output discarded)."""
 
     def run() -> None:
-        subprocess.run(command, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        subprocess.run(
+            command, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=ENV
+        )
 
     return calls(run, repeat)
 
@@ -296,7 +306,7 @@ def batch(count: int, folder: Path) -> None:
             "-q",
         ]
         cpu, start = cpu_of_children(), time.perf_counter()
-        subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+        subprocess.run(command, check=True, stdout=subprocess.DEVNULL, env=ENV)
         return time.perf_counter() - start, cpu_of_children() - cpu
 
     def loop(

@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from geobrep.batch.catalog import SUMMARIES
 from geobrep.batch.pipeline import (
     BuildBlocksStep,
     BuildStep,
@@ -149,21 +150,21 @@ def builtin_operations() -> list[OperationSpec]:
     return [
         OperationSpec(
             name="reproject",
-            summary="transform a model into another CRS",
+            summary=SUMMARIES["reproject"],
             options=ReprojectStep,
             function=_reproject,
             writes="every entity in the target CRS",
         ),
         OperationSpec(
             name="clip",
-            summary="cut a model by a plane or to a box",
+            summary=SUMMARIES["clip"],
             options=ClipStep,
             function=_clip,
             writes="the side kept; cut blocks closed by caps",
         ),
         OperationSpec(
             name="clip_box",
-            summary="keep the inside of a box or of convex planes",
+            summary=SUMMARIES["clip_box"],
             options=ClipBoxStep,
             function=_clip_box,
             command=None,  # `geobrep clip --box`
@@ -171,21 +172,21 @@ def builtin_operations() -> list[OperationSpec]:
         ),
         OperationSpec(
             name="section",
-            summary="section polygons of blocks and traces of surfaces on a plane",
+            summary=SUMMARIES["section"],
             options=SectionStep,
             function=_section,
             writes="one polygon per cut block, one trace per cut surface",
         ),
         OperationSpec(
             name="fit",
-            summary="fit a surface to points (skinning, approximation, kriging, hybrid)",
+            summary=SUMMARIES["fit"],
             options=FitStep,
             function=fit_points,
             writes="the fitted surfaces (and the input with keep_input)",
         ),
         OperationSpec(
             name="build_blocks",
-            summary="build blocks from conformal surfaces",
+            summary=SUMMARIES["build_blocks"],
             options=BuildBlocksStep,
             function=_build_blocks,
             command="blocks",
@@ -193,7 +194,7 @@ def builtin_operations() -> list[OperationSpec]:
         ),
         OperationSpec(
             name="build",
-            summary="run any registered builder",
+            summary=SUMMARIES["build"],
             options=BuildStep,
             function=_build_blocks,
             command=None,
@@ -201,21 +202,21 @@ def builtin_operations() -> list[OperationSpec]:
         ),
         OperationSpec(
             name="voxelize",
-            summary="linear octree of the closed bodies of a model",
+            summary=SUMMARIES["voxelize"],
             options=VoxelizeStep,
             function=_voxelize,
             writes="the scene with its linear octree appended",
         ),
         OperationSpec(
             name="check",
-            summary="inspect models: defects with their locations (exit 3 when found)",
+            summary=SUMMARIES["check"],
             options=CheckStep,
             function=check_scene,
             writes="the scene unchanged (the defects in the summary)",
         ),
         OperationSpec(
             name="repair",
-            summary="mend a model: weld, drop degenerate elements, split T-junctions, orient",
+            summary=SUMMARIES["repair"],
             options=RepairStep,
             function=_repair,
             writes="the repaired scene (properties, ids and names kept)",

@@ -22,7 +22,6 @@ __all__ = ["add_parser", "run"]
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "clean",
-        help="remove temporaries left by interrupted writes",
         description=(
             "Remove the temporary files that interrupted (killed) geobrep writes left in FOLDER: "
             "names like .model.tmp-4242-0a1b2c3d.vtu whose process 4242 is gone. Temporaries "

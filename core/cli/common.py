@@ -26,10 +26,11 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from types import TracebackType
-from typing import Any, Literal, NoReturn, TextIO
+from typing import TYPE_CHECKING, Any, Literal, NoReturn, TextIO
 
-from geobrep.model.entities import Entity
-from geobrep.model.scene import Scene
+if TYPE_CHECKING:
+    from geobrep.model.entities import Entity
+    from geobrep.model.scene import Scene
 
 __all__ = [
     "EXIT_EMPTY",
@@ -339,6 +340,9 @@ class EmptyResultError(Exception):
 
 def is_empty(data: Scene | Entity | Iterable[Entity] | None) -> bool:
     """True when nothing in ``data`` has geometry (no entity, or only empty ones)."""
+    from geobrep.model.entities import Entity
+    from geobrep.model.scene import Scene
+
     if data is None:
         return True
     if isinstance(data, Entity):

@@ -11,7 +11,6 @@ __all__ = ["add_parser"]
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "demo",
-        help="run the demo on the built-in sample model",
         description="Build the faulted layer-cake sample, check its blocks, write the results.",
     )
     parser.add_argument(

@@ -31,9 +31,7 @@ __all__ = ["add_parser", "describe_entity", "describe_scene"]
 
 
 def add_parser(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "info", help="describe a file", description="Describe the entities of a file."
-    )
+    parser = subparsers.add_parser("info", description="Describe the entities of a file.")
     parser.add_argument("file", help="file to describe (any readable format)")
     parser.add_argument(
         "--format", type=format_name("read"), help="format name, when the extension is not enough"
@@ -147,25 +145,30 @@ def _parsed_crs(scene: Scene) -> dict[str, Any] | None:
     A local engineering CRS (GOCAD's ``Default``, ``SKUA Local``) that pyproj cannot read is
     described as such (``"local": True``), not as a failure.
     """
-    if scene.crs is None:
+    crs = scene.crs
+    if crs is None:
         return None
+    if not (crs.epsg or crs.wkt or crs.proj) and _LOCAL_NAME.fullmatch(crs.name or ""):
+        return _local(crs)  # only a local name, which no PROJ CRS has: no need of pyproj
     try:
         from geobrep.gis.crs_ops import describe_crs
     except ImportError:  # pragma: no cover - crs_ops itself is always importable
         return None
     try:
-        return describe_crs(scene.crs)
+        return describe_crs(crs)
     except ImportError:  # pyproj (the gis extra) is not installed
         return None
     except GeobrepError as exc:
-        if local_crs(scene.crs):
-            return {
-                "name": scene.crs.name,
-                "type": "local engineering CRS",
-                "local": True,
-                "units": list(scene.crs.axis_units),
-            }
-        return {"error": str(exc)}
+        return _local(crs) if local_crs(crs) else {"error": str(exc)}
+
+
+def _local(crs: CRS) -> dict[str, Any]:
+    return {
+        "name": crs.name,
+        "type": "local engineering CRS",
+        "local": True,
+        "units": list(crs.axis_units),
+    }
 
 
 def describe_scene(scene: Scene) -> dict[str, Any]:

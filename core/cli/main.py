@@ -1,4 +1,9 @@
-"""Argument parsing and error handling shared by every subcommand."""
+"""Argument parsing and error handling shared by every subcommand.
+
+The top-level parser lists every command from its declaration (:mod:`geobrep.cli.commands`)
+and imports a command's module only when the command is chosen, so ``geobrep --help`` and
+``geobrep info FILE`` load only what they use.
+"""
 
 from __future__ import annotations
 
@@ -7,47 +12,96 @@ import importlib
 import os
 import sys
 import traceback
-from collections.abc import Sequence
-from types import ModuleType
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
 
+from geobrep.cli.commands import COMMANDS, Command
 from geobrep.cli.common import EXIT_EMPTY, CliParser, EmptyResultError, WarningLines, add_verbosity
 from geobrep.errors import GeobrepError
 
-__all__ = ["build_parser", "main"]
+if TYPE_CHECKING:
+    from geobrep.host.operations import OperationSpec
+
+__all__ = ["COMMAND_MODULES", "build_parser", "main"]
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 1, 2, 70, 130
 
-#: Subcommand modules of ``geobrep.cli``, in help order: a command's module has
-#: ``add_parser(subparsers)``; an operation's has ``OPERATION`` (its name), ``run(options,
-#: command)`` and optionally its command model (a class named ``...Command``), ``DESCRIPTION``
-#: and ``clip_options``-like ``OPTIONS_FOR``; its parser is derived from the declarations.
-COMMAND_MODULES = (
-    "info",
-    "plugins",
-    "demo",
-    "convert",
-    "render",
-    "view",
-    "reproject",
-    "clip",
-    "section",
-    "blocks",
-    "voxelize",
-    "check",
-    "repair",
-    "fit",
-    "run",
-    "clean",
-)
+#: Subcommand modules of ``geobrep.cli``, in help order (:data:`~geobrep.cli.commands.COMMANDS`):
+#: a command's module has ``add_parser(subparsers)``; an operation's has ``OPERATION`` (its
+#: name), ``run(options, command)`` and optionally its command model (a class named
+#: ``...Command``), ``DESCRIPTION`` and ``clip_options``-like ``OPTIONS_FOR``; its parser is
+#: derived from the declarations.
+COMMAND_MODULES = tuple(command.module for command in COMMANDS)
+
+#: ``build(subparsers)`` adds a command's real parser.
+Builder = Callable[[Any], None]
 
 
-def _command_modules() -> list[ModuleType]:
-    return [importlib.import_module(f"geobrep.cli.{name}") for name in COMMAND_MODULES]
+class LazySubParsers(argparse._SubParsersAction):  # type: ignore[type-arg]
+    """Subcommands whose parsers are built when chosen: each starts as an empty placeholder
+    with its one-line help (all ``geobrep --help`` needs) and a builder."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.builders: dict[str, Builder] = {}
+
+    def add_lazy(self, name: str, help: str, build: Builder) -> None:
+        """A command listed with ``help`` whose parser ``build(self)`` adds on first use."""
+        self.add_parser(name, help=help)
+        self.builders[name] = build
+
+    def materialize(self, name: str) -> argparse.ArgumentParser:
+        """The real parser of ``name`` (built now if it was not), in the placeholder's place."""
+        build = self.builders.pop(name, None)
+        if build is not None:
+            parsers = self._name_parser_map  # also ``self.choices``: reordered in place
+            order = list(parsers)
+            del parsers[name]
+            build(_Adding(self, name))
+            for key in order:
+                parsers[key] = parsers.pop(key)
+            add_verbosity(parsers[name])
+        parser: argparse.ArgumentParser = self._name_parser_map[name]
+        return parser
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        if values and values[0] in self._name_parser_map:
+            self.materialize(values[0])
+        super().__call__(parser, namespace, values, option_string)
+
+
+class _Adding:
+    """The subparsers action as a command's builder sees it: ``add_parser(name, ...)`` adds the
+    real parser of ``name`` (its help is the placeholder's, already listed)."""
+
+    def __init__(self, action: LazySubParsers, name: str) -> None:
+        self.action, self.name = action, name
+
+    def add_parser(self, name: str, **kwargs: Any) -> argparse.ArgumentParser:
+        """The parser of the command being built (its one-line help: the declaration's)."""
+        if name != self.name:
+            raise ValueError(f"the builder of {self.name!r} added the command {name!r}")
+        kwargs.pop("help", None)  # listed by the placeholder already
+        parser: argparse.ArgumentParser = self.action.add_parser(name, **kwargs)
+        return parser
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The top-level parser with one subparser per command module."""
+    """The top-level parser with every command's parser built (``main`` builds the chosen one)."""
+    parser, commands = _lazy_parser()
+    for name in list(commands.builders):
+        commands.materialize(name)
+    return parser
+
+
+def _lazy_parser() -> tuple[argparse.ArgumentParser, LazySubParsers]:
+    """The top-level parser; each command's own parser is built when the command is chosen."""
     from geobrep import __version__
 
     parser = CliParser(
@@ -56,38 +110,71 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"geobrep {__version__}")
     add_verbosity(parser, top_level=True)
-    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    _add_commands(subparsers)
-    for subparser in {id(p): p for p in subparsers.choices.values()}.values():
-        add_verbosity(subparser)
-    return parser
+    subparsers = parser.add_subparsers(
+        dest="command", metavar="COMMAND", required=True, action=LazySubParsers
+    )
+    assert isinstance(subparsers, LazySubParsers)
+    for command in COMMANDS:
+        subparsers.add_lazy(command.name, command.help, _module_builder(command))
+    for spec in _plugin_operations():
+        subparsers.add_lazy(str(spec.command_name), spec.summary, _plugin_builder(spec))
+    return parser, subparsers
 
 
-def _add_commands(subparsers: Any) -> None:
-    """Every command: the modules', then the operations of plugins that have none."""
-    from geobrep.batch.operations import operations
-    from geobrep.cli.operation import SceneCommand, add_operation_parser, run_scene_operation
+def _module_builder(command: Command) -> Builder:
+    """The builder of a built-in command: its module's parser, or its operation's."""
 
-    registry = operations()
-    for module in _command_modules():
+    def build(subparsers: Any) -> None:
+        module = importlib.import_module(f"geobrep.cli.{command.module}")
         if hasattr(module, "add_parser"):
             module.add_parser(subparsers)
-            continue
-        spec = registry.get(module.OPERATION)
+            return
+        from geobrep.batch.operations import operations
+        from geobrep.cli.operation import SceneCommand, add_operation_parser
+
         add_operation_parser(
             subparsers,
-            spec,
+            operations().get(module.OPERATION),
             module.run,
             command=getattr(module, "COMMAND", SceneCommand),
             description=getattr(module, "DESCRIPTION", None),
             options_for=getattr(module, "OPTIONS_FOR", None),
             extra=module.extra_options() if hasattr(module, "extra_options") else None,
         )
-    for spec in registry:
-        name = spec.command_name
-        if spec.builtin or name is None or name in subparsers.choices:
-            continue
+
+    return build
+
+
+def _plugin_builder(spec: OperationSpec) -> Builder:
+    """The builder of the command of a plugin's operation: read IN, apply, write OUT."""
+
+    def build(subparsers: Any) -> None:
+        from geobrep.cli.operation import add_operation_parser, run_scene_operation
+
         add_operation_parser(subparsers, spec, run_scene_operation(spec))
+
+    return build
+
+
+def _plugin_operations() -> list[OperationSpec]:
+    """The operations of plugins that become commands (a name no command has yet).
+
+    Plugins are loaded for them only when one may exist: geobrep's own plugins add none."""
+    from geobrep.host import only_own_plugins
+
+    if only_own_plugins():
+        return []
+    from geobrep.batch.operations import operations
+
+    taken = {command.name for command in COMMANDS}
+    found: list[OperationSpec] = []
+    for spec in operations():
+        name = spec.command_name
+        if spec.builtin or name is None or name in taken:
+            continue
+        taken.add(name)
+        found.append(spec)
+    return found
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -101,16 +188,14 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(argv: Sequence[str] | None, lines: WarningLines) -> int:
-    try:
-        parser = build_parser()  # loads the plugins: their operations are commands
+    try:  # the chosen command's parser may load the plugins (their operations are commands)
+        args = _lazy_parser()[0].parse_args(argv)
+    except SystemExit as exc:  # argparse: --help/--version (0) or a usage error (2)
+        return int(exc.code or 0)
     except GeobrepError as exc:
         lines.flush()
         print(f"geobrep: error: {exc}", file=sys.stderr)
         return EXIT_ERROR
-    try:
-        args = parser.parse_args(argv)
-    except SystemExit as exc:  # argparse: --help/--version (0) or a usage error (2)
-        return int(exc.code or 0)
     lines.set_verbosity(args.verbosity)
     try:
         return int(args.run(args))

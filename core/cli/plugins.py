@@ -12,7 +12,6 @@ __all__ = ["add_parser"]
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "plugins",
-        help="list plugins and what they register",
         description="List discovered plugins, their distribution and version, and their items.",
     )
     parser.add_argument("--json", action="store_true", help="print JSON for machines")

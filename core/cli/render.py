@@ -111,7 +111,6 @@ class RenderCommand(BaseModel):
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "render",
-        help="render a picture of a model (PNG, off-screen)",
         description="Render a model to a PNG file without a display.",
     )
     add_arguments(parser, RenderCommand)

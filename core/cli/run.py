@@ -23,7 +23,6 @@ __all__ = ["add_parser", "run"]
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "run",
-        help="run a pipeline file (read, clip, fit, build blocks, voxelize, write, ...)",
         description="Run the steps of a pipeline file (YAML or JSON) on each of its inputs. "
         "Every plugin and option is checked before any file is read; a failing input fails "
         "alone and leaves no outputs.",

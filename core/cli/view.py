@@ -20,7 +20,6 @@ __all__ = ["add_parser", "run"]
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "view",
-        help="write a model as one offline HTML page to look at in a browser",
         description="Write MODEL as a self-contained HTML page (3D view, no server needed).",
     )
     parser.add_argument("scene", help="model file (any readable format)")

@@ -13,7 +13,7 @@ if TYPE_CHECKING:
     from geobrep.host.loader import PluginInfo
     from geobrep.host.registry import Registries
 
-__all__ = ["list_plugins", "register", "registries", "reload"]
+__all__ = ["list_plugins", "only_own_plugins", "register", "registries", "reload"]
 
 
 def registries() -> Registries:
@@ -70,3 +70,22 @@ def reload() -> None:
 
     reset()
     get_host()
+
+
+def only_own_plugins() -> bool:
+    """True when every plugin is one of geobrep's own, found without loading any plugin.
+
+    The plugins registered in this process are asked when they were loaded, else the installed
+    entry points (their metadata only). The command line lists its commands without loading
+    plugins when this holds: geobrep's own plugins add no command.
+    """
+    import sys
+    from importlib.metadata import entry_points
+
+    from geobrep.host._entry_points import ENTRY_POINT_GROUP, is_own
+
+    loader = sys.modules.get("geobrep.host.loader")
+    host = getattr(loader, "_host", None) if loader is not None else None
+    if host is not None:
+        return all(info.builtin for info in host.plugins)
+    return all(is_own(entry_point) for entry_point in entry_points(group=ENTRY_POINT_GROUP))

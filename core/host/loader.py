@@ -39,6 +39,10 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from geobrep.errors import PluginError
 from geobrep.hookspecs import PROJECT_NAME, GeobrepSpecs
+from geobrep.host._entry_points import ENTRY_POINT_GROUP
+from geobrep.host._entry_points import distribution as _distribution
+from geobrep.host._entry_points import is_builtin as _is_builtin
+from geobrep.host._entry_points import is_own as _is_own
 from geobrep.host._isolation import (
     STRICT_ENV,
     TIMEOUT_ENV,
@@ -67,7 +71,6 @@ __all__ = [
     "strict_mode",
 ]
 
-ENTRY_POINT_GROUP = "geobrep.plugins"
 DISABLE_ENV = "GEOBREP_DISABLE_PLUGINS"
 
 HOOK_KINDS: dict[str, str] = {
@@ -118,22 +121,6 @@ def disabled_plugins() -> frozenset[str]:
     """Entry-point names listed in ``GEOBREP_DISABLE_PLUGINS`` (comma separated)."""
     raw = os.environ.get(DISABLE_ENV, "")
     return frozenset(part.strip() for part in raw.split(",") if part.strip())
-
-
-def _is_builtin(entry_point: EntryPoint) -> bool:
-    return entry_point.module == PROJECT_NAME or entry_point.module.startswith(PROJECT_NAME + ".")
-
-
-def _distribution(entry_point: EntryPoint) -> tuple[str | None, str | None]:
-    dist = getattr(entry_point, "dist", None)
-    if dist is None:
-        return None, None
-    return dist.name, dist.version
-
-
-def _is_own(entry_point: EntryPoint) -> bool:
-    """A built-in module declared by geobrep's own distribution (or by code, without one)."""
-    return _is_builtin(entry_point) and _distribution(entry_point)[0] in (None, PROJECT_NAME)
 
 
 def discover_entry_points() -> list[EntryPoint]:

@@ -1,0 +1,163 @@
+"""Start-up of the command line (issue 17): a command loads only what it uses.
+
+``geobrep --help`` lists every command from the declarations (:mod:`geobrep.cli.commands`)
+without pydantic, numpy, the entity models or a plugin; ``geobrep info FILE.ts`` reads the file
+without the block builder, pyproj, scipy, the pipeline step models or another command's module.
+Each probe runs in a fresh interpreter and prints the modules it loaded.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from pydantic import BaseModel, ConfigDict
+
+from geobrep import Scene, read
+from geobrep.batch.operations import builtin_operations
+from geobrep.cli.commands import COMMANDS, Command
+from geobrep.cli.main import build_parser, main
+from geobrep.host.loader import set_host
+from geobrep.plugins import OperationRegistry, OperationSpec, hookimpl, register
+
+TSURF = Path(__file__).parents[1] / "data" / "gocad" / "2triangles.ts"
+
+PROBE = """
+import contextlib, io, json, sys
+from geobrep.cli import main
+with contextlib.redirect_stdout(io.StringIO()) as out:
+    code = main(sys.argv[1:])
+print(json.dumps({"code": code, "out": out.getvalue(), "modules": sorted(sys.modules)}))
+"""
+
+#: What listing the commands must not load: the models, numpy, the plugins and their host.
+NOT_FOR_HELP = (
+    "pydantic",
+    "numpy",
+    "pyproj",
+    "geobrep.model",
+    "geobrep.host.loader",
+    "geobrep.host.registry",
+    "geobrep.batch.pipeline",
+    "geobrep.batch.operations",
+    "geobrep.plugins",
+    "geobrep.adapters",
+)
+
+#: What describing a TSurf must not load: kernels, reprojection, other commands, step models.
+NOT_FOR_INFO = (
+    "scipy",
+    "pyproj",
+    "geobrep.gis.crs_ops",
+    "geobrep.plugins.blocks._",
+    "geobrep.plugins.clip._",
+    "geobrep.plugins.voxelize._",
+    "geobrep.plugins.fit._",
+    "geobrep.batch.pipeline",
+    "geobrep.batch.operations",
+    "geobrep.cli.operation",
+    *(f"geobrep.cli.{c.module}" for c in COMMANDS if c.module != "info"),
+)
+
+
+def probe(*args: str) -> dict[str, object]:
+    done = subprocess.run(
+        [sys.executable, "-c", PROBE, *args], capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 0, done.stderr
+    found: dict[str, object] = json.loads(done.stdout.splitlines()[-1])
+    return found
+
+
+def loaded(modules: object, unwanted: tuple[str, ...]) -> list[str]:
+    assert isinstance(modules, list)
+    return [m for m in modules if m in unwanted or m.startswith(tuple(f"{u}." for u in unwanted))]
+
+
+def test_help_lists_every_command_without_loading_models_or_plugins() -> None:
+    found = probe("--help")
+    assert found["code"] == 0
+    assert not loaded(found["modules"], NOT_FOR_HELP)
+    text = str(found["out"])
+    for command in COMMANDS:
+        assert command.name in text
+        assert " ".join(command.help.split()[:3]) in " ".join(text.split())
+
+
+def test_info_of_a_tsurf_loads_only_what_it_needs() -> None:
+    found = probe("info", str(TSURF))
+    assert found["code"] == 0
+    assert "2 faces" in str(found["out"])
+    assert "local (engineering) CRS 'Default'" in str(found["out"])
+    modules = found["modules"]
+    assert not loaded(modules, NOT_FOR_INFO)
+    assert "geobrep.adapters.gocad._reader" in modules  # it did read through GOCAD
+
+
+def test_lazy_help_is_the_help_of_the_whole_parser(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["--help"]) == 0
+    assert capsys.readouterr().out == build_parser().format_help()
+
+
+@pytest.mark.parametrize("command", COMMANDS, ids=lambda c: c.name)
+def test_each_declaration_matches_its_module(command: Command) -> None:
+    module = importlib.import_module(f"geobrep.cli.{command.module}")
+    if command.operation is None:
+        assert hasattr(module, "add_parser")
+        return
+    assert command.operation == module.OPERATION
+    spec = {s.name: s for s in builtin_operations()}[command.operation]
+    assert (spec.command_name, spec.summary) == (command.name, command.help)
+
+
+def test_the_chosen_command_alone_is_built(capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["info", "--help"])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert out.startswith("usage: geobrep info ")
+    assert "--json" in out
+    parser = build_parser()
+    commands = parser._subparsers._group_actions[0].choices  # type: ignore[union-attr]
+    assert list(commands) == [c.name for c in COMMANDS]
+
+
+class _Shift(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    dz: float = 0.0
+    """how far to move the model up"""
+
+
+def _shift(scene: Scene, options: _Shift) -> Scene:
+    up = np.array([0.0, 0.0, options.dz])
+    moved = [s.model_copy(update={"vertices": s.vertices + up}) for s in scene.surfaces]
+    return Scene(entities=moved, crs=scene.crs, name=scene.name)
+
+
+class _ShiftPlugin:
+    @hookimpl
+    def geobrep_register_operations(self, registry: OperationRegistry) -> None:
+        registry.add(
+            OperationSpec(name="shift", summary="move a model up", options=_Shift, function=_shift)
+        )
+
+
+def test_a_plugin_operation_is_a_command(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    previous = set_host(None)
+    try:
+        register(_ShiftPlugin(), "shift-plugin")
+        assert main(["--help"]) == 0
+        assert "shift        move a model up" in capsys.readouterr().out
+        out = tmp_path / "up.ts"
+        assert main(["shift", str(TSURF), str(out), "--dz", "10"]) == 0
+        assert "(shift)" in capsys.readouterr().out
+        before, after = read(TSURF).surfaces[0], read(out).surfaces[0]
+        np.testing.assert_allclose(after.vertices[:, 2], before.vertices[:, 2] + 10.0)
+    finally:
+        set_host(previous)
