@@ -31,7 +31,9 @@ import numpy as np
 
 from geobrep.errors import TopologyError
 from geobrep.geometry import mesh
+from geobrep.geometry.arrays import BoolArray
 from geobrep.geometry.orientation import orientation_flips
+from geobrep.model._shells import Shell, block_shells
 from geobrep.model.entities import Block, PatchSide, Surface
 from geobrep.model.scene import Scene
 
@@ -104,8 +106,8 @@ class BlockOrientation:
         return bool(self.reversed_patches)
 
 
-def _shell_orientation(scene: Scene, block: Block) -> BlockOrientation:
-    shell = scene.block_mesh(block)
+def _shell_orientation(block: Block, shell: Shell | Surface) -> BlockOrientation:
+    """The orientation of ``block`` from its boundary (:meth:`Scene.block_mesh`)."""
     faces = shell.faces
     labels = np.asarray(shell.patch_labels, dtype=np.int64)
     internal = block.internal_patches
@@ -140,13 +142,24 @@ def _shell_orientation(scene: Scene, block: Block) -> BlockOrientation:
     volume = mesh.signed_volume(shell.vertices - centre, oriented)
     # An open shell's volume is only meaningful when it is far from zero (a box with a gap);
     # a closed one must enclose some.
-    area = float(areas.sum())
+    return _decide(block, turn, volume, float(areas.sum()), open_edges)
+
+
+def _decide(
+    block: Block,
+    turn: BoolArray,
+    volume: float,
+    area: float,
+    open_edges: int,
+) -> BlockOrientation:
+    """The sides of ``block`` once its shell is oriented (``turn``: per boundary side)."""
     decided = abs(volume) > _OPEN_VOLUME_SHARE * area**1.5
     if (volume < 0) != block.is_universe and (decided or not open_edges):
         turn = ~turn
         volume = -volume
     if not open_edges and (volume == 0.0 or not np.isfinite(volume)):
         raise TopologyError(f"{block.label}: its boundary encloses no volume")
+    internal = block.internal_patches
     new_sides: list[PatchSide] = []
     reversed_patches: list[int] = []
     position = 0
@@ -165,11 +178,17 @@ def _shell_orientation(scene: Scene, block: Block) -> BlockOrientation:
 
 def block_orientations(scene: Scene) -> list[BlockOrientation]:
     """How each block of ``scene`` (the universe included) must list its sides."""
-    out = []
-    for block in scene.of_type(Block):
-        if block.sides and any(s.patch not in block.internal_patches for s in block.sides):
-            out.append(_shell_orientation(scene, block))
-    return out
+    blocks = [
+        block
+        for block in scene.of_type(Block)
+        if block.sides and any(s.patch not in block.internal_patches for s in block.sides)
+    ]
+    if not blocks:
+        return []
+    return [
+        _shell_orientation(block, shell)
+        for block, shell in zip(blocks, block_shells(scene, blocks), strict=True)
+    ]
 
 
 def orient_blocks(scene: Scene) -> tuple[Scene, list[str]]:
