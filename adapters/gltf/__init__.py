@@ -9,9 +9,11 @@ Registers two formats (extra ``web``; 3D Tiles also need pyproj, extra ``gis``):
   entity id, unit per mesh). The file records the largest float32 rounding it made
   (``asset.extras.geobrep.float32_rounding_m``): about 0.2 mm for a 10 km model.
 - ``3dtiles``: a tileset JSON (any ``.json`` name; ``tileset.json`` by custom) and its content
-  ``<stem>.glb`` beside it, in east-north-up metres with the ENU-to-ECEF root transform from
-  the scene's CRS (pyproj), so Cesium shows the model at its true place. A scene without a CRS
-  is refused unless ``longitude``, ``latitude`` and ``height`` say where its centre goes.
+  ``<stem>.glb`` beside it (a model of more than ``max_tile_triangles``: one ``<stem>_<n>.glb``
+  tile per surface, polyline, point set and block, each with its bounding box), in
+  east-north-up metres with the ENU-to-ECEF root transform from the scene's CRS (pyproj), so
+  Cesium shows the model at its true place. A scene without a CRS is refused unless
+  ``longitude``, ``latitude`` and ``height`` say where its centre goes.
 
 pygltflib (pure Python, maintained, a complete typed model of the glTF 2.0 schema with
 extras/extensions as plain JSON and binary-chunk handling) writes and loads the container;
@@ -28,7 +30,12 @@ from pydantic import BaseModel, ConfigDict, Field
 from geobrep.adapters._file_format import full_capabilities
 from geobrep.adapters.gltf._frame import OffsetFrame
 from geobrep.adapters.gltf._read import read_glb
-from geobrep.adapters.gltf._tiles import read_tileset, tiles_frame, write_tileset
+from geobrep.adapters.gltf._tiles import (
+    MAX_TILE_TRIANGLES,
+    read_tileset,
+    tiles_frame,
+    write_tileset,
+)
 from geobrep.adapters.gltf._write import build_glb
 from geobrep.errors import OptionsError
 from geobrep.hookspecs import hookimpl
@@ -71,6 +78,9 @@ class TilesOptions(BaseModel):
     height: float | None = None
     """Ellipsoidal height of the model's centre (metres)."""
     blocks: bool = True
+    max_tile_triangles: int = Field(default=MAX_TILE_TRIANGLES, ge=1)
+    """A model with more triangles (segments, points) than this is written as one tile per
+    surface, polyline, point set and block, each with its bounding box."""
 
 
 def _origin(scene: Scene, origin: tuple[float, float, float] | None) -> OffsetFrame:
@@ -95,7 +105,14 @@ def _write_glb(scene: Scene, path: Path, options: GltfOptions) -> None:
 
 def _write_tiles(scene: Scene, path: Path, options: TilesOptions) -> None:
     frame = tiles_frame(scene, options.longitude, options.latitude, options.height)
-    write_tileset(scene, restrict_scene(scene, CAPABILITIES), path, frame, blocks=options.blocks)
+    write_tileset(
+        scene,
+        restrict_scene(scene, CAPABILITIES),
+        path,
+        frame,
+        blocks=options.blocks,
+        max_tile_triangles=options.max_tile_triangles,
+    )
 
 
 def _sniff_glb(head: bytes) -> bool:

@@ -29,7 +29,7 @@ from geobrep.model.entities import Block, Entity, PolyLine, Surface
 from geobrep.model.properties import PropertyMap
 from geobrep.model.scene import Scene
 
-__all__ = ["GEOBREP_KEY", "GlbContent", "build_glb", "write_glb"]
+__all__ = ["GEOBREP_KEY", "GlbContent", "build_glb", "glb_meshes", "write_glb"]
 
 GEOBREP_KEY: Final = "geobrep"
 FORMAT_VERSION: Final = 1
@@ -242,6 +242,17 @@ def _property_table(buffer: _Buffer, rows: list[dict[str, Any]]) -> dict[str, An
     }
 
 
+def glb_meshes(scene: Scene, blocks: bool, written: Scene | None) -> list[tuple[Entity, Entity]]:
+    """The ``(geometry, source)`` meshes a .glb of ``scene`` holds: the entities ``written``
+    keeps (the scene restricted to the format), then the blocks' boundaries."""
+    kept = written if written is not None else scene
+    return [
+        (geometry, source)
+        for geometry, source in drawn_meshes(scene, blocks)
+        if source is not geometry or source.id in kept.entity_by_id or isinstance(source, Block)
+    ]
+
+
 def build_glb(
     scene: Scene,
     frame: Frame,
@@ -249,21 +260,22 @@ def build_glb(
     blocks: bool = True,
     written: Scene | None = None,
     extras: dict[str, Any] | None = None,
+    meshes: list[tuple[Entity, Entity]] | None = None,
 ) -> GlbContent:
     """The .glb bytes of ``scene`` in ``frame``.
 
     ``written`` is what the file keeps as entities (``scene`` restricted to the format); the
-    blocks' meshes come from the full ``scene``.
+    blocks' meshes come from the full ``scene``. ``meshes`` (from :func:`glb_meshes`) picks
+    some of them: one tile of a tileset.
     """
     pygltflib = import_pygltflib("writing glTF files")
     kept = written if written is not None else scene
     colours = scene_colours(scene)
     buffer, out = _Buffer(), _Meshes()
     default = (0.7, 0.7, 0.7, 1.0)
-    for geometry, source in drawn_meshes(scene, blocks):
-        if source is not geometry or source.id in kept.entity_by_id or isinstance(source, Block):
-            colour = default if source.id is None else colours.get(source.id, default)
-            _add_mesh(out, buffer, frame, geometry, source, colour)
+    for geometry, source in glb_meshes(scene, blocks, written) if meshes is None else meshes:
+        colour = default if source.id is None else colours.get(source.id, default)
+        _add_mesh(out, buffer, frame, geometry, source, colour)
     scene_extras: dict[str, Any] = {
         "version": FORMAT_VERSION,
         "name": kept.name,

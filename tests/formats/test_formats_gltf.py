@@ -293,3 +293,108 @@ def test_tileset_of_a_gocad_local_crs_takes_the_georeference(tmp_path: Path) -> 
     assert back.crs == scene.crs
     for original, again in zip(scene.surfaces, back.surfaces, strict=True):
         assert np.abs(again.vertices - original.vertices).max() < MILLIMETRE
+
+
+def _check_tile(tile: dict, parent_error: float, folder: Path, is_root: bool) -> int:
+    """The 3D Tiles 1.1 rules a tile must follow (tileset.schema.json, tile.schema.json,
+    boundingVolume.schema.json); the number of tiles with content below and at ``tile``."""
+    assert set(tile) <= {"boundingVolume", "geometricError", "refine", "content", "children",
+                         "transform", "viewerRequestVolume", "extras", "extensions"}  # fmt: skip
+    volume = tile["boundingVolume"]
+    assert list(volume) == ["box"]
+    assert len(volume["box"]) == 12
+    assert all(np.isfinite(volume["box"]))
+    assert 0.0 <= tile["geometricError"] <= parent_error  # never more than the parent's
+    if is_root:
+        assert tile["refine"] in ("ADD", "REPLACE")
+        assert len(tile["transform"]) == 16
+        assert all(np.isfinite(tile["transform"]))
+    else:
+        assert "transform" not in tile  # the children share the root's ENU frame
+    contents = 0
+    if "content" in tile:
+        uri = tile["content"]["uri"]
+        assert (folder / uri).is_file()
+        assert not Path(uri).is_absolute()
+        _check_content_inside(folder / uri, np.asarray(volume["box"], np.float64))
+        contents += 1
+    children = tile.get("children", [])
+    assert children or "content" in tile  # a leaf has something to draw
+    if children:
+        assert tile["geometricError"] > 0  # refining adds what the tile lacks
+    for child in children:
+        contents += _check_tile(child, tile["geometricError"], folder, False)
+    return contents
+
+
+def _check_content_inside(glb: Path, box: np.ndarray) -> None:
+    """Every position of the tile's glTF (y up, as 3D Tiles turn it z up) lies in its box."""
+    gltf = pygltflib.GLTF2.load(str(glb))
+    centre, half = box[:3], box[[3, 7, 11]]
+    for accessor in (
+        gltf.accessors[p.attributes.POSITION] for m in gltf.meshes for p in m.primitives
+    ):
+        low = np.asarray(accessor.min)[[0, 2, 1]] * [1, -1, 1]
+        high = np.asarray(accessor.max)[[0, 2, 1]] * [1, -1, 1]
+        low, high = np.minimum(low, high), np.maximum(low, high)  # y up -> z up: -z is north
+        assert (low >= centre - half - 1e-3).all()
+        assert (high <= centre + half + 1e-3).all()
+
+
+def test_large_model_is_a_tileset_of_one_tile_per_mesh(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    blocks = [b for b in scene.blocks if b is not scene.universe]
+    n_triangles = sum(s.n_faces for s in scene.surfaces)
+    tileset = write(scene, tmp_path / "tileset.json", max_tile_triangles=n_triangles - 1)
+    document = json.loads(tileset.read_text())
+    assert document["asset"]["version"] == "1.1"
+    root = document["root"]
+    assert "content" not in root
+    assert len(root["children"]) == len(scene.surfaces) + len(blocks)
+    assert _check_tile(root, document["geometricError"], tmp_path, True) == len(root["children"])
+    assert root["geometricError"] == pytest.approx(document["geometricError"])
+    # each tile is one named mesh, at its true ECEF place through the root transform
+    matrix = np.asarray(root["transform"], np.float64).reshape(4, 4).T
+    for surface, child in zip(scene.surfaces, root["children"], strict=False):
+        content = trimesh.load(tmp_path / child["content"]["uri"], force="scene")
+        assert list(content.geometry) == [surface.name]
+        y_up = np.asarray(content.geometry[surface.name].vertices, np.float64)
+        z_up = np.column_stack([y_up[:, 0], -y_up[:, 2], y_up[:, 1]])
+        placed = z_up @ matrix[:3, :3].T + matrix[:3, 3]
+        assert np.abs(placed - _ecef(scene, surface.vertices)).max() < MILLIMETRE
+    # read back: the same scene as from one tile, within the float32 error of the original
+    back = read(tileset)
+    single = read(write(scene, tmp_path / "single.json"))
+    assert json.loads((tmp_path / "single.json").read_text())["root"]["content"]["uri"]
+    assert back == single
+    assert back.groups == single.groups
+    assert len(back.metadata[SKIPPED_ON_READ]) == len(blocks)
+    for original, again in zip(scene.surfaces, back.surfaces, strict=True):
+        assert (again.id, again.name, again.kind) == (original.id, original.name, original.kind)
+        assert np.abs(again.vertices - original.vertices).max() < MILLIMETRE
+        assert np.array_equal(again.faces, original.faces)
+        assert again.point_data == original.point_data
+
+
+def test_single_tile_tileset_follows_the_tile_rules(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    document = json.loads(write(scene, tmp_path / "tileset.json").read_text())
+    assert _check_tile(document["root"], document["geometricError"], tmp_path, True) == 1
+
+
+def test_tileset_tree_damage_is_a_format_error(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    tileset = write(scene, tmp_path / "tileset.json", max_tile_triangles=1)
+    document = json.loads(tileset.read_text())
+    document["root"]["children"][1]["content"]["uri"] = "../outside.glb"
+    tileset.write_text(json.dumps(document))
+    with pytest.raises(FormatError, match="beside the tileset"):
+        read(tileset)
+    document["root"]["children"] = {"not": "a list"}
+    tileset.write_text(json.dumps(document))
+    with pytest.raises(FormatError, match="children are not a list"):
+        read(tileset)
+    document["root"]["children"] = []
+    tileset.write_text(json.dumps(document))
+    with pytest.raises(FormatError, match="no content"):
+        read(tileset)
