@@ -89,7 +89,7 @@ def _write_data(root: h5py.Group, obj: h5py.Group, props: PropertyMap, associati
         if values.ndim != 1 or values.dtype.kind not in "biuf":
             continue  # vectors: reported as lost
         primitive = "Float" if values.dtype.kind == "f" else "Integer"
-        stored = values.astype(np.float64 if primitive == "Float" else np.int32)
+        stored = np.asarray(values, dtype=np.float64 if primitive == "Float" else np.int32)
         ident, type_ident = _uid(), _uid()
         data = root["Data"].create_group(ident)
         data.attrs.update({"ID": ident, "Name": name, "Association": association, **_ENTITY_FLAGS})
