@@ -6,10 +6,12 @@ from __future__ import annotations
 import inspect
 import re
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 import geobrep
+import geobrep.plugins
 import geobrep.schemas
 from geobrep.batch.operations import builtin_operations, docs_tables, update_docs
 from geobrep.batch.pipeline import option_names
@@ -31,21 +33,84 @@ FUNCTIONS = {
     "voxelize": (geobrep.voxelize, {}),
     "check": (geobrep.inspect, {}),
     "repair": (geobrep.repair, {}),
+    "convert": (geobrep.convert, {"format": "to", "options": "write_options"}),
 }
 #: Keys that say what a step does with the scene, not how the function works.
 STEP_ONLY = {
     "fit": {"points", "keep_input", "check", "max_triangles"},
     "check": {"on_defects"},  # what the step does with defects: fail, warn or continue
+    "convert": {"name", "allow_empty"},  # the output's name and empty results: the command's
 }
 #: Commands whose parser is derived from the declaration (the rest are listed in the report).
-DERIVED = {"reproject", "clip", "section", "voxelize", "fit", "build_blocks", "check", "repair"}
+DERIVED = {
+    "render",
+    "view",
+    "reproject",
+    "clip",
+    "section",
+    "voxelize",
+    "fit",
+    "build_blocks",
+    "check",
+    "repair",
+    "convert",
+}
+
+
+#: Operations whose result is a file a format's writer makes (their function is geobrep.write):
+#: a value for every option that is not the default, so each can be seen reaching the writer.
+WRITERS: dict[str, tuple[str, dict[str, Any]]] = {
+    "render": (
+        "png",
+        {
+            "color_by": "block",
+            "property": "depth",
+            "clip_origin": (1.0, 2.0, 3.0),
+            "clip_normal": (0.0, 0.0, 1.0),
+            "section_origin": (4.0, 5.0, 6.0),
+            "section_normal": (1.0, 0.0, 0.0),
+            "view": "top",
+            "azimuth": 30.0,
+            "elevation": -10.0,
+            "title": "T",
+            "legend": False,
+            "axes": False,
+            "scale_bar": False,
+            "size": (640, 480),
+            "edges": True,
+            "vertical_exaggeration": 2.5,
+        },
+    ),
+    "view": ("html", {"title": "T", "blocks": False, "all_surfaces": True}),
+}
+#: Options every step that writes a file has: where its file goes and whether it may be empty.
+OUTPUT_KEYS = {"name", "allow_empty"}
+PAIRS = {"clip_origin": "clip_normal", "section_origin": "section_normal"}
 
 
 def test_every_operation_has_a_function() -> None:
-    assert set(FUNCTIONS) == set(SPECS)
+    assert set(FUNCTIONS) | set(WRITERS) == set(SPECS)
+    assert not set(FUNCTIONS) & set(WRITERS)
 
 
-@pytest.mark.parametrize("name", sorted(SPECS))
+@pytest.mark.parametrize("name", sorted(WRITERS))
+def test_every_option_reaches_the_writer(name: str) -> None:
+    spec = SPECS[name]
+    format_name, sample = WRITERS[name]
+    assert spec.output == "files"
+    assert spec.options.fixed_format == format_name
+    assert set(sample) == set(option_names(spec.options)) - OUTPUT_KEYS
+    writer = geobrep.plugins.registries().formats.get(format_name)
+    default = spec.options().writer_options()
+    writer.validate_options(default)
+    writer.validate_options(spec.options(**sample).writer_options())
+    pairs = {**PAIRS, **{b: a for a, b in PAIRS.items()}}
+    for key, value in sample.items():
+        changed = {key: value, **({pairs[key]: sample[pairs[key]]} if key in pairs else {})}
+        assert spec.options(**changed).writer_options() != default, f"{name}: {key} is lost"
+
+
+@pytest.mark.parametrize("name", sorted(FUNCTIONS))
 def test_function_takes_every_option(name: str) -> None:
     function, renamed = FUNCTIONS[name]
     parameters = inspect.signature(function).parameters

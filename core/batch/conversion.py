@@ -31,7 +31,7 @@ from multiprocessing.connection import Connection
 from multiprocessing.context import DefaultContext
 from os import PathLike
 from pathlib import Path
-from typing import Any, Generic, Literal, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, Literal, TypeVar
 
 from pydantic import BaseModel, ConfigDict
 
@@ -41,11 +41,13 @@ from geobrep.host.capabilities import (
     format_losses,
     has_geometry,
     restrict_scene,
-    without_read_losses,
 )
-from geobrep.host.registry import FormatCapabilities
+from geobrep.host.registry import FormatCapabilities, FormatSpec
 from geobrep.model.scene import Scene
 from geobrep.ops.io import read, write
+
+if TYPE_CHECKING:
+    from geobrep.batch.pipeline import Pipeline
 
 __all__ = [
     "ConversionSummary",
@@ -54,12 +56,16 @@ __all__ = [
     "PipelineSummary",
     "StepReport",
     "WorkerDiedError",
+    "conversion_pipeline",
     "convert",
     "convert_file",
+    "convert_one",
     "demo_stage",
     "expand",
+    "file_losses",
     "run_each",
     "verify_read_back",
+    "verify_written",
     "worker_failure",
 ]
 
@@ -206,6 +212,65 @@ def expand(inputs: PathArg | Iterable[PathArg]) -> list[Path]:
     return paths
 
 
+def conversion_pipeline(
+    read_format: str | None = None,
+    write_format: str | None = None,
+    name: str = "{stem}",
+    write_options: dict[str, Any] | None = None,
+    verify: bool = False,
+    tessellate: bool = False,
+) -> Pipeline:
+    """The pipeline a conversion is: a ``read`` step, then a ``convert`` step (a write).
+
+    >>> [step.kind for step in conversion_pipeline(write_format="vtu").step_list]
+    ['read', 'convert']
+    """
+    from geobrep.batch.pipeline import ConvertStep, Pipeline, ReadStep
+
+    write_step = ConvertStep(
+        format=write_format,
+        name=name,
+        options=dict(write_options or {}),
+        verify=verify,
+        tessellate=tessellate,
+        allow_empty=True,  # convert writes what it read; the command line refuses it (exit 4)
+    )
+    return Pipeline(steps=(ReadStep(format=read_format), write_step))
+
+
+def convert_one(pipeline: Pipeline, source: Path, target: Path, contain: bool = True) -> FileReport:
+    """Run a conversion pipeline (:func:`conversion_pipeline`) on one file, as a FileReport.
+
+    It runs through the pipeline executor (:func:`geobrep.batch.pipeline_run.run_steps`);
+    never raises: a failure is a report with ``error`` set.
+    """
+    from geobrep.batch.pipeline_run import run_steps
+
+    report, error = run_steps(pipeline, source, (target,), contain=contain)
+    if report.status == "failed":
+        return FileReport(
+            source=source,
+            target=target,
+            status="failed",
+            error=error or report.error,
+            seconds=report.seconds,
+        )
+    prefix = f"{target.name}: "
+    return FileReport(
+        source=source,
+        target=target,
+        status="converted",
+        lost=tuple(loss.removeprefix(prefix) for loss in report.lost),
+        entities=report.steps[-1].entities if report.steps else 0,
+        seconds=report.seconds,
+    )
+
+
+def _literal(name: str) -> str:
+    """A file name as a name pattern that gives itself (braces doubled)."""
+    return name.replace("{", "{{").replace("}", "}}")
+
+
 def convert_file(
     source: Path,
     target: Path,
@@ -214,6 +279,7 @@ def convert_file(
     write_options: dict[str, Any] | None = None,
     verify: bool = False,
     out_dir: Path | None = None,
+    tessellate: bool = False,
 ) -> FileReport:
     """Convert one file; never raises: a failure is a report with ``error`` set.
 
@@ -221,41 +287,41 @@ def convert_file(
     as lost makes the file fail. With ``out_dir``, ``target`` must resolve inside that folder
     when it is written (see :func:`geobrep.batch.outputs.contained`).
     """
-    started = time.perf_counter()
-    try:
-        from geobrep.host import registries
-
-        scene = read(source, format=read_format)
-        spec = registries().formats.choose_writer(target, write_format)
-        lost = format_losses(scene, spec, target)
-        scene = without_read_losses(scene)  # it describes the source, not what is written
-        if out_dir is not None:
-            contained(target, out_dir)  # planned inside; still inside now (symlinks)?
-        write(scene, target, format=spec.name, **(write_options or {}))
-        if verify:
-            try:
-                back = read(target, format=spec.name)
-            except GeobrepError as exc:
-                raise FormatError(f"verify: the written file cannot be read back: {exc}") from exc
-            problems = verify_read_back(scene, back, spec.capabilities, lost)
-            if problems:
-                raise FormatError(
-                    f"verify: {target.name} read back differs from the report: "
-                    + "; ".join(problems[:5])
-                    + (f" (and {len(problems) - 5} more)" if len(problems) > 5 else "")
-                )
-    except GeobrepError as exc:
-        return _failed(source, target, str(exc), started)
-    except Exception as exc:  # a bug or a library failure: still this file's problem only
-        return _failed(source, target, f"{type(exc).__name__}: {exc}", started)
-    return FileReport(
-        source=source,
-        target=target,
-        status="converted",
-        lost=tuple(lost),
-        entities=len(scene.entities),
-        seconds=time.perf_counter() - started,
+    if out_dir is not None and target.parent.resolve() != out_dir.resolve():
+        started = time.perf_counter()
+        try:
+            contained(target, out_dir)
+        except GeobrepError as exc:
+            return _failed(source, target, str(exc), started)
+    pipeline = conversion_pipeline(
+        read_format, write_format, _literal(target.name), write_options, verify, tessellate
     )
+    return convert_one(pipeline, source, target, contain=out_dir is not None)
+
+
+def file_losses(scene: Scene, spec: FormatSpec, target: Path) -> list[str]:
+    """What ``target``, written by ``spec``, cannot hold of ``scene`` (the sentences of a report;
+    see :func:`geobrep.host.capabilities.format_losses`)."""
+    return format_losses(scene, spec, target)
+
+
+def verify_written(scene: Scene, target: Path, format_name: str, lost: Sequence[str]) -> None:
+    """Read ``target`` back; raise :class:`FormatError` unless it holds what ``scene`` held,
+    less what ``lost`` reports (see :func:`verify_read_back`)."""
+    from geobrep.host import registries
+
+    spec = registries().formats.get(format_name)
+    try:
+        back = read(target, format=spec.name)
+    except GeobrepError as exc:
+        raise FormatError(f"verify: the written file cannot be read back: {exc}") from exc
+    problems = verify_read_back(scene, back, spec.capabilities, lost)
+    if problems:
+        raise FormatError(
+            f"verify: {target.name} read back differs from the report: "
+            + "; ".join(problems[:5])
+            + (f" (and {len(problems) - 5} more)" if len(problems) > 5 else "")
+        )
 
 
 def verify_read_back(
@@ -394,6 +460,7 @@ def convert(
     write_options: dict[str, Any] | None = None,
     progress: Progress | None = None,
     verify: bool = False,
+    tessellate: bool = False,
 ) -> ConversionSummary[FileReport]:
     """Convert files; returns the per-file reports (it never stops at a bad file).
 
@@ -404,7 +471,12 @@ def convert(
     ``"tcp://scheduler:8786"``) runs the files on a Dask cluster instead. ``progress(report,
     done, total)`` is called as each file finishes. ``verify=True`` reads each written file
     back and fails the file when something is missing that its report does not list as lost
-    (see :func:`verify_read_back`).
+    (see :func:`verify_read_back`); ``tessellate=True`` writes NURBS surfaces as meshes when
+    the format cannot hold them (otherwise they are reported lost).
+
+    Each file goes through the pipeline executor: the conversion is a ``read`` step and a
+    ``convert`` step (:func:`conversion_pipeline`; ``geobrep run`` with those two steps writes
+    the same files).
 
     Raises:
         OptionsError: contradictory arguments (several inputs and one output file, no format).
@@ -433,16 +505,35 @@ def convert(
             progress(report, len(results), total)
 
     indices = [i for i, t in enumerate(targets) if isinstance(t, Path)]
-    arguments = [(s, t, read_format, write_format, write_options, verify, folder) for s, t in work]
+    arguments = [
+        (
+            conversion_pipeline(
+                read_format, write_format, _pattern(t, folder), write_options, verify, tessellate
+            ),
+            s,
+            t,
+            folder is not None,
+        )
+        for s, t in work
+    ]
 
     def finished(position: int, report: FileReport | None, error: BaseException | None) -> None:
         if report is None:  # the worker died (killed, out of memory)
-            source, target = arguments[position][:2]
+            source, target = arguments[position][1:3]
             report = _failed(source, target, worker_failure(error), 0.0)
         done(indices[position], report)
 
-    run_each(convert_file, arguments, finished, jobs=jobs if len(work) > 1 else 1, client=client)
+    run_each(convert_one, arguments, finished, jobs=jobs if len(work) > 1 else 1, client=client)
     return PipelineSummary[FileReport](reports=tuple(results[i] for i in range(total)))
+
+
+def _pattern(target: Path, folder: Path | None) -> str:
+    """The name pattern of a conversion's write step: ``{stem}`` and the extension into a
+    folder, the output's own name for one file."""
+    if folder is None:
+        return _literal(target.name)
+    stem = target.name.split(".")[0]
+    return "{stem}" + _literal(target.name[len(stem) :])
 
 
 def run_each(

@@ -25,10 +25,13 @@ from geobrep.batch.pipeline import (
     CheckStep,
     ClipBoxStep,
     ClipStep,
+    ConvertStep,
     FitStep,
+    RenderStep,
     RepairStep,
     ReprojectStep,
     SectionStep,
+    ViewStep,
     VoxelizeStep,
 )
 from geobrep.errors import EntityNotFoundError, OptionsError
@@ -36,7 +39,14 @@ from geobrep.host.operations import OperationRegistry, OperationSpec, options_ta
 from geobrep.model.entities import Entity, PointSet, PolyLine
 from geobrep.model.scene import Scene
 
-__all__ = ["builtin_operations", "docs_tables", "fit_inputs", "operations", "update_docs"]
+__all__ = [
+    "as_written",
+    "builtin_operations",
+    "docs_tables",
+    "fit_inputs",
+    "operations",
+    "update_docs",
+]
 
 
 def _scene(result: Any, scene: Scene) -> Scene:
@@ -145,6 +155,14 @@ def _repair(scene: Scene, step: RepairStep) -> Scene:
     return repair(scene, step.actions, step.tolerance)[0]
 
 
+def as_written(scene: Scene, step: Any) -> Scene:
+    """The scene a step that writes a file writes: ``scene`` without the reader's list of
+    what it skipped (that describes the source, not the file written)."""
+    from geobrep.host.capabilities import without_read_losses
+
+    return without_read_losses(scene)
+
+
 def builtin_operations() -> list[OperationSpec]:
     """geobrep's own operations, in the order the documentation presents them."""
     return [
@@ -220,6 +238,34 @@ def builtin_operations() -> list[OperationSpec]:
             options=RepairStep,
             function=_repair,
             writes="the repaired scene (properties, ids and names kept)",
+        ),
+        OperationSpec(
+            name="convert",
+            summary="convert files between formats",
+            description="Convert one file (IN OUT), or many files into a folder "
+            "(IN... --to FMT -o DIR). What the target format cannot hold is reported per file.",
+            options=ConvertStep,
+            function=as_written,
+            output="files",
+            writes="a file per input in another format (the scene flows on unchanged)",
+        ),
+        OperationSpec(
+            name="render",
+            summary="render a picture of a model (PNG, off-screen)",
+            description="Render a model to a PNG file without a display.",
+            options=RenderStep,
+            function=as_written,
+            output="files",
+            writes="a PNG picture of the scene (the scene flows on unchanged)",
+        ),
+        OperationSpec(
+            name="view",
+            summary="write a model as one offline HTML page to look at in a browser",
+            description="Write MODEL as a self-contained HTML page (3D view, no server needed).",
+            options=ViewStep,
+            function=as_written,
+            output="files",
+            writes="an HTML page of the scene (the scene flows on unchanged)",
         ),
     ]
 

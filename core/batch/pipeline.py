@@ -30,6 +30,7 @@ geobrep.errors.OptionsError: pipeline: step 1: unknown step kind 'clipp'; step k
 
 from __future__ import annotations
 
+import argparse
 import json
 from collections.abc import Mapping
 from os import PathLike
@@ -78,12 +79,15 @@ __all__ = [
     "ConvertStep",
     "FitStep",
     "OperationStep",
+    "OutputStep",
     "Pipeline",
     "ReadStep",
+    "RenderStep",
     "RepairStep",
     "ReprojectStep",
     "SectionStep",
     "StepOptions",
+    "ViewStep",
     "VoxelizeStep",
     "WriteStep",
     "option_names",
@@ -387,45 +391,58 @@ class RepairStep(StepOptions):
     """weld/contact tolerance (default: from the data's precision)"""
 
 
-class WriteStep(StepOptions):
-    """Write the scene as it is at this step (the scene flows on unchanged) to
-    ``<output>/<name>``: ``format`` names a registered format, ``name`` a file-name pattern with
-    the bare fields ``{stem}``, ``{name}``, ``{ext}``, ``{index}``, ``{half}`` (default
-    ``{stem}`` + the format's extension; no attribute access, indexing or format spec, and the
-    file must lie in the output folder); ``options`` are the format's. NURBS surfaces are
-    tessellated when the format cannot hold them (``tessellate``). After a clip keeping both
-    sides, the step writes each half (see :meth:`Pipeline.halves`). Files appear only when the
-    whole pipeline succeeded for that input."""
+class OutputStep(StepOptions):
+    """A step that writes a file (``write``, ``convert``, ``render``, ``view``): the scene as
+    it is at this step goes to ``<output>/<name>`` and flows on unchanged. ``name`` is a
+    file-name pattern with the bare fields ``{stem}``, ``{name}``, ``{ext}``, ``{index}``,
+    ``{half}`` (no attribute access, indexing or format spec, and the file must lie in the
+    output folder). After a clip keeping both sides, the step writes each half (see
+    :meth:`Pipeline.halves`). Files appear only when the whole pipeline succeeded for that
+    input."""
 
-    kind: ClassVar[str] = "write"
+    #: The format every step of this kind writes (None: the step's own ``format``).
+    fixed_format: ClassVar[str | None] = None
 
-    format: str | None = None
     name: str | None = None
-    options: Options = Field(default_factory=dict)
-    tessellate: bool = True
+    """the file-name pattern (default: {stem} and the format's extension)"""
     allow_empty: bool = False
     """Write a scene with nothing in it (by default that fails the input: a clip that missed
     the model should not pass for a result)."""
 
     @model_validator(mode="after")
-    def _target(self) -> WriteStep:
-        if self.format is None and self.name is None:
-            raise ValueError("give a format, a file name pattern (name), or both")
+    def _pattern(self) -> OutputStep:
         if self.name is not None:
             check_name_pattern(self.name)
         return self
+
+    def writer_format(self) -> str | None:
+        """The registered format written (None: from the file name's extension)."""
+        return self.fixed_format
+
+    def writer_options(self) -> dict[str, Any]:
+        """The keywords of the format's writer."""
+        return {}
+
+    def tessellates(self) -> bool:
+        """Whether NURBS surfaces become meshes for a format that cannot hold them."""
+        return False
+
+    def verifies(self) -> bool:
+        """Whether each written file is read back and checked against its report."""
+        return False
 
     def pattern(self, registries: Registries) -> str:
         """The file-name pattern, with the format's extension when ``name`` is not given."""
         if self.name is not None:
             return self.name
-        spec = registries.formats.get(str(self.format))
+        spec = registries.formats.get(str(self.writer_format()))
         return "{stem}" + (spec.extensions[0] if spec.extensions else f".{spec.name}")
 
     def format_name(self, registries: Registries) -> str:
         """The registered format this step writes with."""
-        if self.format is not None:
-            return self.format
+        written = self.writer_format()
+        if written is not None:
+            return written
         fields: dict[str, str | int] = {
             "stem": "x",
             "name": "x.x",
@@ -437,22 +454,195 @@ class WriteStep(StepOptions):
         return registries.formats.choose_writer(Path(sample)).name
 
     def check(self, registries: Registries) -> None:
-        if self.format is not None:
-            spec = _get(registries.formats, self.format)
+        written = self.writer_format()
+        if written is not None:
+            spec = _get(registries.formats, written)
             if not spec.can_write:
                 raise OptionsError(
-                    f"format {self.format!r} cannot write; formats that can: "
+                    f"format {written!r} cannot write; formats that can: "
                     + ", ".join(s.name for s in registries.formats.writers())
                 )
         else:
             spec = registries.formats.get(self.format_name(registries))
-        spec.validate_options(self.options)
+        spec.validate_options(self.writer_options())
+
+
+class WriteStep(OutputStep):
+    """Write the scene as it is at this step (the scene flows on unchanged) to
+    ``<output>/<name>``: ``format`` names a registered format, ``name`` a file-name pattern
+    (see :class:`OutputStep`; default ``{stem}`` + the format's extension); ``options`` are the
+    format's. NURBS surfaces are tessellated when the format cannot hold them
+    (``tessellate``)."""
+
+    kind: ClassVar[str] = "write"
+
+    format: str | None = None
+    options: Options = Field(default_factory=dict)
+    tessellate: bool = True
+    verify: bool = False
+    """Read each written file back: a file that lacks something its report does not list as
+    lost fails the input."""
+
+    @model_validator(mode="after")
+    def _target(self) -> WriteStep:
+        if self.format is None and self.name is None:
+            raise ValueError("give a format, a file name pattern (name), or both")
+        return self
+
+    def writer_format(self) -> str | None:
+        return self.format
+
+    def writer_options(self) -> dict[str, Any]:
+        return dict(self.options)
+
+    def tessellates(self) -> bool:
+        return self.tessellate
+
+    def verifies(self) -> bool:
+        return self.verify
 
 
 class ConvertStep(WriteStep):
-    """The same as ``write``: ``convert: {format: vtu}`` reads naturally after ``read``."""
+    """Write the scene as it was read, as ``geobrep convert`` does: the same as ``write`` but
+    NURBS surfaces the format cannot hold are reported lost rather than tessellated (unless
+    ``tessellate``); ``convert: {format: vtu}`` reads naturally after ``read``. On the command
+    line ``--to`` gives ``format``, and ``OUT`` or ``-o DIR`` the file ``name``."""
 
     kind: ClassVar[str] = "convert"
+
+    format: Annotated[str | None, Cli(hidden=True)] = None
+    """the format written (geobrep convert: --to)"""
+    name: Annotated[str | None, Cli(hidden=True)] = None
+    """the file-name pattern (geobrep convert: OUT's name, or {stem} and the extension)"""
+    options: Annotated[
+        Options,
+        Cli(
+            flags=("--option",), append=True, parse=key_value, collect=as_dict, metavar="KEY=VALUE"
+        ),
+    ] = Field(default_factory=dict)
+    """the options of the format's writer"""
+    tessellate: bool = False
+    """write NURBS surfaces as meshes when the format cannot hold them (otherwise they are
+    reported lost)"""
+
+
+def _triple(text: str) -> tuple[float, float, float]:
+    """A ``parse`` for three numbers, separated by commas or spaces: ``1,2,3``, ``"0 0 1"``."""
+    try:
+        values = tuple(float(v) for v in text.replace(",", " ").split())
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected three numbers, got {text!r}") from None
+    if len(values) != 3:
+        raise argparse.ArgumentTypeError(f"expected three numbers, got {text!r}")
+    return values[0], values[1], values[2]
+
+
+Triple = tuple[float, float, float]
+View = Literal["isometric", "top", "bottom", "north", "south", "east", "west"]
+
+
+class RenderStep(OutputStep):
+    """Render a picture of the scene off-screen (the ``png`` format: pyvista, extra ``viz``),
+    as ``geobrep render`` does: colour by entity, block or property, a cut-away plane or a
+    section, a legend, axes in world coordinates, a scale bar and the CRS in the title;
+    ``name`` defaults to ``{stem}.png``. The scene flows on unchanged."""
+
+    kind: ClassVar[str] = "render"
+    fixed_format: ClassVar[str | None] = "png"
+
+    name: Annotated[str | None, Cli(hidden=True)] = None
+    """the file-name pattern (default: {stem}.png; geobrep render: OUT)"""
+    color_by: Literal["entity", "block", "property"] | None = None
+    """colour each entity, each block, or by a property (default: entity; property when
+    --property is given)"""
+    property: str | None = None
+    """property to colour by"""
+    clip_origin: Annotated[Triple | None, Cli(parse=_triple, metavar="X,Y,Z")] = None
+    """a point of the cut-away plane"""
+    clip_normal: Annotated[Triple | None, Cli(parse=_triple, metavar="NX,NY,NZ")] = None
+    """normal of the cut-away plane (the side it points to is removed)"""
+    section_origin: Annotated[Triple | None, Cli(parse=_triple, metavar="X,Y,Z")] = None
+    """a point of the section plane"""
+    section_normal: Annotated[Triple | None, Cli(parse=_triple, metavar="NX,NY,NZ")] = None
+    """normal of the section plane: the side it points to is removed, blocks are closed by the
+    cut, and the picture looks at the cut"""
+    view: View | None = None
+    """where the camera looks from (default: isometric, or square to the section)"""
+    azimuth: Annotated[float, Cli(metavar="DEG")] = 0.0
+    """turn the camera about the vertical by DEG degrees"""
+    elevation: Annotated[float, Cli(metavar="DEG")] = 0.0
+    """raise the camera by DEG degrees"""
+    title: str | None = None
+    """the picture's title (default: model name and CRS)"""
+    legend: Annotated[bool, Cli(negate="--no-legend")] = True
+    """no legend of names and colours"""
+    axes: Annotated[bool, Cli(negate="--no-axes")] = True
+    """no axes with coordinates"""
+    scale_bar: Annotated[bool, Cli(negate="--no-scale-bar")] = True
+    """no scale bar"""
+    size: Annotated[tuple[int, int], Cli(nargs=2, parse=int, metavar=("W", "H"))] = (1200, 900)
+    """picture size in pixels"""
+    edges: bool = False
+    """draw triangle edges"""
+    vertical_exaggeration: Annotated[float, Cli(metavar="F")] = 1.0
+    """scale of z relative to x and y"""
+
+    def writer_options(self) -> dict[str, Any]:
+        """The options of the ``png`` writer these options give.
+
+        Raises:
+            OptionsError: a plane's origin without its normal, or its normal without its origin.
+        """
+        for name in ("clip", "section"):
+            if (getattr(self, f"{name}_origin") is None) != (
+                getattr(self, f"{name}_normal") is None
+            ):
+                raise OptionsError(f"--{name}-origin and --{name}-normal go together")
+        return {
+            "color_by": self.color_by or ("property" if self.property else "entity"),
+            "property": self.property,
+            "clip_origin": self.clip_origin,
+            "clip_normal": self.clip_normal,
+            "window_size": tuple(self.size),
+            "show_edges": self.edges,
+            "vertical_exaggeration": self.vertical_exaggeration,
+            "section_origin": self.section_origin,
+            "section_normal": self.section_normal,
+            "view": self.view,
+            "azimuth": self.azimuth,
+            "elevation": self.elevation,
+            "title": self.title,
+            "legend": self.legend,
+            "axes": self.axes,
+            "scale_bar": self.scale_bar,
+        }
+
+
+class ViewStep(OutputStep):
+    """Write the scene as one offline HTML page to look at in a browser (the ``html`` format:
+    three.js inlined, blocks and surfaces switchable, a clipping plane, axes in world
+    coordinates), as ``geobrep view`` does; ``name`` defaults to ``{stem}.html``. The scene
+    flows on unchanged."""
+
+    kind: ClassVar[str] = "view"
+    fixed_format: ClassVar[str | None] = "html"
+
+    name: Annotated[str | None, Cli(hidden=True)] = None
+    """the file-name pattern (default: {stem}.html; geobrep view: -o)"""
+    title: str | None = None
+    """the page's title (default: the model's name)"""
+    blocks: Annotated[bool, Cli(negate="--no-blocks")] = True
+    """do not show blocks (only surfaces, lines, points)"""
+    all_surfaces: bool = False
+    """with blocks, start with every surface shown too (default: only faults)"""
+
+    def writer_options(self) -> dict[str, Any]:
+        """The options of the ``html`` writer these options give."""
+        return {
+            "title": self.title,
+            "blocks": self.blocks,
+            "surfaces_with_blocks": self.all_surfaces,
+        }
 
 
 class OperationStep(StepOptions):
@@ -506,6 +696,8 @@ _STEP_TYPES: tuple[type[StepOptions], ...] = (
     RepairStep,
     WriteStep,
     ConvertStep,
+    RenderStep,
+    ViewStep,
 )
 STEP_KINDS: tuple[str, ...] = tuple(t.kind for t in _STEP_TYPES)
 """Every step kind, in the order the documentation presents them."""
@@ -575,6 +767,14 @@ class ConvertEntry(_Entry):
     convert: ConvertStep
 
 
+class RenderEntry(_Entry):
+    render: RenderStep
+
+
+class ViewEntry(_Entry):
+    view: ViewStep
+
+
 class OperationEntry(_Entry):
     operation: OperationStep
 
@@ -604,6 +804,8 @@ Step = Annotated[
         Annotated[RepairEntry, Tag("repair")],
         Annotated[WriteEntry, Tag("write")],
         Annotated[ConvertEntry, Tag("convert")],
+        Annotated[RenderEntry, Tag("render")],
+        Annotated[ViewEntry, Tag("view")],
         SkipJsonSchema[Annotated[OperationEntry, Tag("operation")]],
     ],
     Discriminator(_step_tag),
@@ -659,7 +861,7 @@ class Pipeline(BaseModel):
             raise ValueError(
                 f"step {kinds.index('read', 1) + 1}: read must be the first step (or left out)"
             )
-        if not {"write", "convert"} & set(kinds):
+        if not any(isinstance(step, OutputStep) for step in self.step_list):
             raise ValueError("the pipeline writes nothing: add a write step")
         return self
 
@@ -677,8 +879,14 @@ class Pipeline(BaseModel):
     def allowing_empty(self) -> Pipeline:
         """This pipeline with every write step writing empty results too (``--allow-empty``)."""
         steps = [
-            entry.model_copy(update={"write": entry.body.model_copy(update={"allow_empty": True})})
-            if isinstance(entry.body, WriteStep)
+            entry.model_copy(
+                update={
+                    next(iter(type(entry).model_fields)): entry.body.model_copy(
+                        update={"allow_empty": True}
+                    )
+                }
+            )
+            if isinstance(entry.body, OutputStep)
             else entry
             for entry in self.steps
         ]
@@ -758,7 +966,7 @@ class Pipeline(BaseModel):
                     for half in halves
                     for side in ("negative", "positive")
                 )
-            elif isinstance(step, WriteStep):
+            elif isinstance(step, OutputStep):
                 per_write.append(halves)
         return per_write
 
@@ -780,12 +988,13 @@ class Pipeline(BaseModel):
         writes = [
             (number, step.pattern(registries))
             for number, step in enumerate(self.step_list, 1)
-            if isinstance(step, WriteStep)
+            if isinstance(step, OutputStep)
         ]
         for (number, pattern), halves in zip(writes, self.halves(), strict=True):
             if uses_half(pattern) and halves == ("",):
                 raise OptionsError(
-                    f"{self._source}: step {number} (write): name pattern {pattern!r} uses "
+                    f"{self._source}: step {number} ({self.step_list[number - 1].kind}): name "
+                    f"pattern {pattern!r} uses "
                     "{half}, but no clip step before it keeps both sides"
                 )
         seen: dict[str, int] = {}

@@ -34,7 +34,9 @@ from geobrep.batch.conversion import (
     PipelineSummary,
     StepReport,
     expand,
+    file_losses,
     run_each,
+    verify_written,
     worker_failure,
 )
 from geobrep.batch.outputs import OutputFolder, contained, half_name, name_fields
@@ -47,12 +49,15 @@ from geobrep.batch.pipeline import (
     ConvertStep,
     FitStep,
     OperationStep,
+    OutputStep,
     Pipeline,
     ReadStep,
+    RenderStep,
     RepairStep,
     ReprojectStep,
     SectionStep,
     StepOptions,
+    ViewStep,
     VoxelizeStep,
     WriteStep,
 )
@@ -62,7 +67,7 @@ from geobrep.errors import (
     OptionsError,
     TopologyError,
 )
-from geobrep.host.capabilities import format_losses
+from geobrep.host.capabilities import without_read_losses
 from geobrep.model.entities import Entity, LinearOctree, NurbsSurface, Surface
 from geobrep.model.scene import Scene
 from geobrep.ops.io import read, write
@@ -78,6 +83,7 @@ __all__ = [
     "plan_outputs",
     "run_file",
     "run_pipeline",
+    "run_steps",
 ]
 
 PathArg = str | PathLike[str]
@@ -109,7 +115,7 @@ def plan_outputs(
     keeps the name).
     """
     patterns = [
-        step.pattern(registries) for step in pipeline.step_list if isinstance(step, WriteStep)
+        step.pattern(registries) for step in pipeline.step_list if isinstance(step, OutputStep)
     ]
     folder = OutputFolder(out_dir)
     inputs = {source.resolve() for source in sources}
@@ -223,6 +229,21 @@ def run_pipeline(
 
 
 # ------------------------------------------------------------------------------- one input
+@dataclass(frozen=True)
+class _Output:
+    """A file a write step makes once every step of the input succeeded."""
+
+    number: int
+    kind: str
+    target: Path
+    scene: Scene
+    format: str
+    options: dict[str, Any]
+    verify: bool
+    lost: tuple[str, ...]
+    """What the format cannot hold of ``scene`` (checked on read-back with ``verify``)."""
+
+
 @dataclass
 class _Work:
     """What the steps of one input share."""
@@ -230,11 +251,13 @@ class _Work:
     source: Path
     targets: tuple[Path, ...]
     registries: Registries
+    contain: bool = True
+    """Check that each output still resolves inside its folder right before writing it."""
     number: int = 0
     """The step running (0: the implicit read)."""
     kind: str = "read"
-    pending: list[tuple[int, str, Path, Scene, str, dict[str, Any]]] = field(default_factory=list)
-    """Outputs to write once every step succeeded: (step, kind, target, scene, format, options)."""
+    pending: list[_Output] = field(default_factory=list)
+    """Outputs to write once every step succeeded."""
     lost: list[str] = field(default_factory=list)
     fits: list[tuple[NurbsSurface, FitResult, FitStep]] = field(default_factory=list)
     """The NURBS surfaces fit steps made, with their results: a write step that tessellates one
@@ -246,6 +269,17 @@ def run_file(pipeline: Pipeline, source: Path, targets: tuple[Path, ...]) -> Pip
 
     ``targets`` are the files of the write steps, in order (see :func:`plan_outputs`).
     """
+    return run_steps(pipeline, source, targets)[0]
+
+
+def run_steps(
+    pipeline: Pipeline, source: Path, targets: tuple[Path, ...], *, contain: bool = True
+) -> tuple[PipelineFileReport, str | None]:
+    """:func:`run_file`, and the error of a failed input without the step that raised it.
+
+    ``contain``: each target must still resolve inside its own folder when it is written (off
+    for the one file ``geobrep convert IN OUT`` writes wherever ``OUT`` is).
+    """
     from geobrep.host import registries
 
     started = time.perf_counter()
@@ -254,7 +288,7 @@ def run_file(pipeline: Pipeline, source: Path, targets: tuple[Path, ...]) -> Pip
     numbered: list[tuple[int, StepOptions]] = list(enumerate(bodies, 1))
     if not isinstance(bodies[0], ReadStep):
         numbered.insert(0, (0, ReadStep()))
-    work = _Work(source=source, targets=targets, registries=registries())
+    work = _Work(source=source, targets=targets, registries=registries(), contain=contain)
     try:
         branches: list[tuple[str, Scene]] = [("", Scene())]
         for work.number, body in numbered:
@@ -278,7 +312,7 @@ def run_file(pipeline: Pipeline, source: Path, targets: tuple[Path, ...]) -> Pip
     except Exception as exc:
         error = str(exc) if isinstance(exc, GeobrepError) else f"{type(exc).__name__}: {exc}"
         where = f"step {work.number} ({work.kind})" if work.number else work.kind
-        return PipelineFileReport(
+        failed = PipelineFileReport(
             source=source,
             status="failed",
             error=f"{where}: {error}",
@@ -286,7 +320,8 @@ def run_file(pipeline: Pipeline, source: Path, targets: tuple[Path, ...]) -> Pip
             steps=tuple(reports),
             seconds=time.perf_counter() - started,
         )
-    return PipelineFileReport(
+        return failed, error
+    done = PipelineFileReport(
         source=source,
         status="done",
         outputs=targets,
@@ -294,6 +329,7 @@ def run_file(pipeline: Pipeline, source: Path, targets: tuple[Path, ...]) -> Pip
         lost=tuple(work.lost),
         seconds=time.perf_counter() - started,
     )
+    return done, None
 
 
 def _write_outputs(work: _Work) -> dict[int, float]:
@@ -304,13 +340,17 @@ def _write_outputs(work: _Work) -> dict[int, float]:
     written: list[Path] = []
     spent: dict[int, float] = {}
     try:
-        for number, kind, target, scene, format_name, options in work.pending:
-            work.number, work.kind = number, kind
+        for output in work.pending:
+            work.number, work.kind = output.number, output.kind
             begun = time.perf_counter()
-            contained(target, target.parent)  # planned inside; still inside now (symlinks)?
-            write(scene, target, format=format_name, **options)
+            target = output.target
+            if work.contain:  # planned inside; still inside now (symlinks)?
+                contained(target, target.parent)
+            write(output.scene, target, format=output.format, **output.options)
             written.append(target)
-            spent[number] = time.perf_counter() - begun
+            if output.verify:
+                verify_written(output.scene, target, output.format, output.lost)
+            spent[output.number] = time.perf_counter() - begun
     except BaseException:
         for path in written:
             path.unlink(missing_ok=True)
@@ -337,7 +377,7 @@ def _step(body: StepOptions, branches: Branches, work: _Work) -> tuple[Branches,
             continue
         applied, said = _APPLY.get(type(body), _operation)(body, scene, work)
         result.append((half, applied))
-        named = half and not isinstance(body, WriteStep)  # a write's notes name its file
+        named = half and not isinstance(body, OutputStep)  # a write's notes name its file
         notes.extend(f"{half}: {note}" if named else note for note in said)
     return result, notes
 
@@ -483,7 +523,7 @@ def _operation(step: OperationStep, scene: Scene, work: _Work) -> Applied:
     return result, []
 
 
-def _write(step: WriteStep, scene: Scene, work: _Work) -> Applied:
+def _write(step: OutputStep, scene: Scene, work: _Work) -> Applied:
     target = work.targets[len(work.pending)]
     if scene.bounds is None and not step.allow_empty:  # nothing with geometry in it
         raise GeobrepError(
@@ -491,17 +531,29 @@ def _write(step: WriteStep, scene: Scene, work: _Work) -> Applied:
             "the model?); give the write step allow_empty: true (geobrep run --allow-empty) to "
             "write it anyway"
         )
-    format_name = step.format_name(work.registries)
-    spec = work.registries.formats.get(format_name)
+    spec = work.registries.formats.choose_writer(target, step.writer_format())
     caps = spec.capabilities
     held = caps.entity_types
     meshes: list[str] = []
-    if step.tessellate and held and "NurbsSurface" not in held and "Surface" in held:
-        scene, meshes = _tessellated(scene, work, target)
-    losses = [f"{target.name}: {loss}" for loss in format_losses(scene, spec, target)]
+    written = scene
+    if step.tessellates() and held and "NurbsSurface" not in held and "Surface" in held:
+        written, meshes = _tessellated(scene, work, target)
+    lost = tuple(file_losses(written, spec, target))
+    losses = [f"{target.name}: {loss}" for loss in lost]
     work.lost.extend(losses)
-    work.pending.append((work.number, step.kind, target, scene, format_name, dict(step.options)))
-    return scene, [*meshes, *(losses or [f"{target.name}: nothing lost"])]
+    work.pending.append(
+        _Output(
+            number=work.number,
+            kind=step.kind,
+            target=target,
+            scene=without_read_losses(written),  # they describe the source, not the file
+            format=spec.name,
+            options=step.writer_options(),
+            verify=step.verifies(),
+            lost=lost,
+        )
+    )
+    return written, [*meshes, *(losses or [f"{target.name}: nothing lost"])]
 
 
 def _tessellated(scene: Scene, work: _Work, target: Path) -> tuple[Scene, list[str]]:
@@ -580,4 +632,6 @@ _APPLY: dict[type[StepOptions], Callable[[Any, Scene, _Work], Applied]] = {
     RepairStep: _repair,
     WriteStep: _write,
     ConvertStep: _write,
+    RenderStep: _write,
+    ViewStep: _write,
 }

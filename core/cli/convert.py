@@ -5,70 +5,96 @@
 ``DIR/<stem>.<ext>``. Each file's losses are reported; the exit code is 1 if any file failed,
 with every failure listed. ``--verify`` reads each written file back: a file that lacks
 something its report does not list as lost fails.
+
+A conversion is a read step and a ``convert`` step run by the pipeline executor
+(:func:`geobrep.batch.conversion.convert`); the parser is derived from the ``convert``
+operation (:class:`~geobrep.batch.pipeline.ConvertStep`: ``--verify``, ``--option``,
+``--tessellate``) and :class:`ConvertCommand` (the files, ``--to``, ``--jobs``, ...).
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Annotated, Any, Protocol
+
+from pydantic import BaseModel, ConfigDict
 
 from geobrep.batch.conversion import ConversionSummary, FileReport, convert
-from geobrep.cli.common import add_allow_empty, format_name, refuse_empty
+from geobrep.batch.pipeline import ConvertStep
+from geobrep.cli.common import format_name, refuse_empty
 from geobrep.errors import OptionsError
+from geobrep.host.operations import Cli, options_from_args
 
-__all__ = ["add_parser", "run"]
+__all__ = [
+    "COMMAND",
+    "OPERATION",
+    "OPTIONS_FOR",
+    "ConvertCommand",
+    "ProgressBar",
+    "convert_options",
+    "run",
+]
+
+OPERATION = "convert"
 
 
-def add_parser(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "convert",
-        help="convert files between formats",
-        description="Convert one file (IN OUT), or many files into a folder "
-        "(IN... --to FMT -o DIR). What the target format cannot hold is reported per file.",
-    )
-    parser.add_argument(
-        "paths",
-        nargs="+",
-        metavar="PATH",
-        help="input file(s) or glob(s), then the output file when converting one file without --to",
-    )
-    parser.add_argument(
-        "--to",
-        type=format_name("write"),
-        metavar="FMT",
-        help="target format name or extension (many files)",
-    )
-    parser.add_argument("-o", "--output-dir", metavar="DIR", help="output folder (many files)")
-    parser.add_argument(
-        "--jobs",
-        "-j",
-        type=int,
-        default=1,
-        metavar="N",
-        help="convert N files at a time in worker processes",
-    )
-    parser.add_argument(
-        "--dask", metavar="ADDRESS", help="run on a Dask cluster, e.g. tcp://scheduler:8786"
-    )
-    parser.add_argument(
-        "--format",
-        dest="read_format",
-        type=format_name("read"),
-        metavar="NAME",
-        help="input format, when the extension is not enough",
-    )
-    parser.add_argument(
-        "--verify",
-        action="store_true",
-        help="read each written file back; a file missing what its report keeps fails",
-    )
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-    parser.add_argument("--json", action="store_true", help="print the reports as JSON")
-    add_allow_empty(parser)
-    parser.set_defaults(run=run)
+class ConvertCommand(BaseModel):
+    """The files and the command-line-only options of ``geobrep convert``."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+    paths: Annotated[tuple[str, ...], Cli(positional=True, nargs="+", metavar="PATH")]
+    """input file(s) or glob(s), then the output file when converting one file without --to"""
+    to: Annotated[str | None, Cli(parse=format_name("write"), metavar="FMT")] = None
+    """target format name or extension (many files)"""
+    output_dir: Annotated[str | None, Cli(flags=("-o", "--output-dir"), metavar="DIR")] = None
+    """output folder (many files)"""
+    jobs: Annotated[int, Cli(flags=("--jobs", "-j"), metavar="N")] = 1
+    """convert N files at a time in worker processes"""
+    dask: Annotated[str | None, Cli(metavar="ADDRESS")] = None
+    """run on a Dask cluster, e.g. tcp://scheduler:8786"""
+    format: Annotated[str | None, Cli(parse=format_name("read"), metavar="NAME")] = None
+    """input format, when the extension is not enough"""
+    no_progress: bool = False
+    """no progress bar"""
+    as_json: Annotated[bool, Cli(flags=("--json",))] = False
+    """print the reports as JSON"""
+    allow_empty: bool = False
+    """accept a result with nothing in it (otherwise: a warning and exit 4)"""
+
+    def output(self) -> str | None:
+        """The output file of ``IN OUT`` (None when converting into a folder)."""
+        if self.to is not None or self.output_dir is not None:
+            return None
+        if len(self.paths) != 2:
+            raise OptionsError("give IN OUT for one file, or IN... --to FMT -o DIR for many files")
+        return self.paths[-1]
+
+    def inputs(self) -> list[str]:
+        """The input paths and patterns."""
+        return list(self.paths[:-1] if self.output() is not None else self.paths)
+
+
+def convert_options(command: ConvertCommand, given: Mapping[str, Any]) -> ConvertStep:
+    """The ``convert`` step the arguments give: ``--to`` (a format name) is its format, the
+    output file's name or ``{stem}.EXT`` its name."""
+    from geobrep.host import registries
+
+    output = command.output()
+    to = command.to
+    data: dict[str, Any] = dict(given)
+    if to is not None and to in registries().formats:
+        data["format"] = to
+    elif to is not None:
+        data["name"] = "{stem}." + to.lstrip(".")
+    elif output is not None:
+        data["name"] = Path(output).name.replace("{", "{{").replace("}", "}}")
+    else:  # -o DIR without --to: convert() says a folder needs the target format
+        data["name"] = "{stem}"
+    return options_from_args(ConvertStep, data)  # type: ignore[no-any-return]
 
 
 class Reported(Protocol):
@@ -102,32 +128,29 @@ class ProgressBar:
         sys.stderr.flush()
 
 
-def run(args: argparse.Namespace) -> int:
-    paths: list[str] = list(args.paths)
-    output = None
-    if args.to is None and args.output_dir is None:
-        if len(paths) != 2:
-            raise OptionsError("give IN OUT for one file, or IN... --to FMT -o DIR for many files")
-        output = paths.pop()
-    progress = ProgressBar(enabled=not args.no_progress and not args.json and sys.stderr.isatty())
+def run(step: ConvertStep, command: ConvertCommand) -> int:
+    as_json = command.as_json
+    progress = ProgressBar(enabled=not command.no_progress and not as_json and sys.stderr.isatty())
     summary = convert(
-        paths,
-        output,
-        to=args.to,
-        out_dir=args.output_dir,
-        jobs=args.jobs,
-        client=args.dask,
-        read_format=args.read_format,
+        command.inputs(),
+        command.output(),
+        to=command.to,
+        out_dir=command.output_dir,
+        jobs=command.jobs,
+        client=command.dask,
+        read_format=command.format,
+        write_options=step.writer_options(),
         progress=progress,
-        verify=args.verify,
+        verify=step.verify,
+        tessellate=step.tessellate,
     )
-    _print(summary, args.json)
+    _print(summary, as_json)
     if not summary.ok:
         return 1
     empty = [
         f"{r.target}: nothing read from {r.source}" for r in summary.converted if not r.entities
     ]
-    refuse_empty(args, empty, consequence="the file holds nothing")
+    refuse_empty(command, empty, consequence="the file holds nothing")
     return 0
 
 
@@ -138,3 +161,7 @@ def _print(summary: ConversionSummary[FileReport], as_json: bool) -> None:
         print(summary.table())
     for report in summary.failed:
         print(f"geobrep: failed: {report.source}: {report.error}", file=sys.stderr)
+
+
+COMMAND = ConvertCommand
+OPTIONS_FOR = convert_options

@@ -2,56 +2,50 @@
 
 The page lists the blocks and surfaces with their names and colours, each switchable, has a
 clipping plane and axes labelled in world coordinates, and needs no server: open it from disk.
-Writing goes through the registered ``html`` format.
+Writing goes through the registered ``html`` format. The parser is derived from the ``view``
+operation (:class:`~geobrep.batch.pipeline.ViewStep`: ``--title``, ``--no-blocks``,
+``--all-surfaces``) and :class:`ViewCommand` (the files).
 """
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
-from typing import Any
+from typing import Annotated
 
-from geobrep.cli.common import add_allow_empty, format_name, read_input
+from pydantic import BaseModel, ConfigDict
+
+from geobrep.batch.operations import as_written
+from geobrep.batch.pipeline import ViewStep
+from geobrep.cli.common import format_name, read_input
+from geobrep.host.operations import Cli
 from geobrep.ops.io import write
 
-__all__ = ["add_parser", "run"]
+__all__ = ["COMMAND", "OPERATION", "ViewCommand", "run"]
+
+OPERATION = "view"
 
 
-def add_parser(subparsers: Any) -> None:
-    parser = subparsers.add_parser(
-        "view",
-        description="Write MODEL as a self-contained HTML page (3D view, no server needed).",
-    )
-    parser.add_argument("scene", help="model file (any readable format)")
-    parser.add_argument(
-        "-o", "--output", help="page to write (default: MODEL's name with .html, here)"
-    )
-    parser.add_argument(
-        "--format", type=format_name("read"), help="input format, when the extension is not enough"
-    )
-    parser.add_argument("--title", help="the page's title (default: the model's name)")
-    parser.add_argument(
-        "--no-blocks", action="store_true", help="do not show blocks (only surfaces, lines, points)"
-    )
-    parser.add_argument(
-        "--all-surfaces",
-        action="store_true",
-        help="with blocks, start with every surface shown too (default: only faults)",
-    )
-    add_allow_empty(parser)
-    parser.set_defaults(run=run)
+class ViewCommand(BaseModel):
+    """The files of ``geobrep view``."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+    scene: Annotated[str, Cli(positional=True)]
+    """model file (any readable format)"""
+    output: Annotated[str | None, Cli(flags=("-o", "--output"))] = None
+    """page to write (default: MODEL's name with .html, here)"""
+    format: Annotated[str | None, Cli(parse=format_name("read"))] = None
+    """input format, when the extension is not enough"""
+    allow_empty: bool = False
+    """accept a result with nothing in it (otherwise: a warning and exit 4)"""
 
 
-def run(args: argparse.Namespace) -> int:
-    scene = read_input(args, args.scene, format=args.format)
-    output = args.output or Path(args.scene).with_suffix(".html").name
-    path = write(
-        scene,
-        output,
-        format="html",
-        title=args.title,
-        blocks=not args.no_blocks,
-        surfaces_with_blocks=args.all_surfaces,
-    )
+def run(step: ViewStep, command: ViewCommand) -> int:
+    scene = read_input(command, command.scene, format=command.format)
+    output = command.output or Path(command.scene).with_suffix(".html").name
+    path = write(as_written(scene, step), output, format="html", **step.writer_options())
     print(f"wrote {path}")
     return 0
+
+
+COMMAND = ViewCommand

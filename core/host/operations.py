@@ -45,6 +45,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "Cli",
+    "FileOptions",
     "OperationFunction",
     "OperationRegistry",
     "OperationSpec",
@@ -181,6 +182,22 @@ class OperationFunction(Protocol):
     def __call__(self, scene: Scene, options: Any, /) -> Scene: ...
 
 
+@runtime_checkable
+class FileOptions(Protocol):
+    """The options of an operation whose result is files written (``output="files"``)."""
+
+    name: str | None
+    """The file-name pattern of its output in a pipeline (``{stem}.png``)."""
+
+    def writer_format(self) -> str | None:
+        """The registered format written (None: from the output's extension)."""
+        ...
+
+    def writer_options(self) -> dict[str, Any]:
+        """The keywords of the format's writer."""
+        ...
+
+
 class OperationSpec(RegisteredItem):
     """One operation: its options model and its function of a Scene.
 
@@ -207,6 +224,11 @@ class OperationSpec(RegisteredItem):
     command: str | None = ""
     step: str | None = ""
     writes: str = "the scene the function returns"
+    output: Literal["scene", "files"] = "scene"
+    """``"scene"``: the result is the new scene the function returns. ``"files"``: the result
+    is files written (``convert``, ``render``, ``view``): the options are a step that writes a
+    file (:class:`FileOptions`: they name the format and give its writer's keywords), the
+    function returns the scene to write, and in a pipeline the scene flows on unchanged."""
 
     @property
     def command_name(self) -> str | None:
