@@ -241,7 +241,7 @@ def builtin_operations() -> list[OperationSpec]:
         ),
         OperationSpec(
             name="convert",
-            summary="convert files between formats",
+            summary=SUMMARIES["convert"],
             description="Convert one file (IN OUT), or many files into a folder "
             "(IN... --to FMT -o DIR). What the target format cannot hold is reported per file.",
             options=ConvertStep,
@@ -251,7 +251,7 @@ def builtin_operations() -> list[OperationSpec]:
         ),
         OperationSpec(
             name="render",
-            summary="render a picture of a model (PNG, off-screen)",
+            summary=SUMMARIES["render"],
             description="Render a model to a PNG file without a display.",
             options=RenderStep,
             function=as_written,
@@ -260,7 +260,7 @@ def builtin_operations() -> list[OperationSpec]:
         ),
         OperationSpec(
             name="view",
-            summary="write a model as one offline HTML page to look at in a browser",
+            summary=SUMMARIES["view"],
             description="Write MODEL as a self-contained HTML page (3D view, no server needed).",
             options=ViewStep,
             function=as_written,
