@@ -25,7 +25,7 @@ at once, naming the step (counted from 1), its kind and the option. Running is d
 >>> Pipeline.from_data({"steps": [{"clipp": {}}]})
 Traceback (most recent call last):
 ...
-geobrep.errors.OptionsError: pipeline: step 1: unknown step kind 'clipp'; step kinds: read, reproject, clip, ..., write, convert
+geobrep.errors.OptionsError: pipeline: step 1: unknown step kind 'clipp'; step kinds: read, reproject, clip, ..., render, view
 """  # noqa: E501
 
 from __future__ import annotations
