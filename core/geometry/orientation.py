@@ -3,8 +3,8 @@
 Two faces sharing a *manifold* edge (one used by exactly two face sides) agree when they run
 along it in opposite directions. :func:`orientation_flips` finds, for every connected piece of
 the mesh (faces joined through manifold edges), the flips that make all its faces agree with
-one face of the piece (its *root*), in O(M log M): a breadth-first spanning forest from scipy,
-then the flip parities summed along the tree by pointer jumping (log₂ of the tree depth passes).
+one face of the piece (its *root*), in O(M log M): the two states of every face (as is,
+reversed) joined where neighbours agree, and scipy's connected components of those states.
 Edges used by more than two faces do not join faces: the orientation is not decided there.
 
 >>> import numpy as np
@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 from geobrep.geometry.arrays import BoolArray, IntArray
 from geobrep.geometry.mesh import _as_faces, _edge_table
 
-__all__ = ["OrientationFlips", "orientation_flips"]
+__all__ = ["OrientationFlips", "neighbour_pairs", "orientation_flips"]
 
 
 @dataclass(frozen=True)
@@ -44,8 +44,17 @@ class OrientationFlips:
 
 def _neighbour_pairs(faces: IntArray) -> tuple[IntArray, IntArray, BoolArray]:
     """Face pairs across manifold edges, and whether they run the edge the same way."""
-    k = faces.shape[1]
     _, _, offsets, perm = _edge_table(faces)
+    return neighbour_pairs(faces, offsets, perm)
+
+
+def neighbour_pairs(
+    faces: IntArray, offsets: IntArray, perm: IntArray
+) -> tuple[IntArray, IntArray, BoolArray]:
+    """Face pairs across the edges two face sides use, and whether they run the edge the same
+    way, from an edge table: the sides of edge ``e`` are ``perm[offsets[e]:offsets[e + 1]]``
+    (flattened face sides, ``face * k + side``)."""
+    k = faces.shape[1]
     counts = np.diff(offsets)
     first = offsets[:-1][counts == 2]
     side_a, side_b = perm[first], perm[first + 1]
@@ -56,34 +65,32 @@ def _neighbour_pairs(faces: IntArray) -> tuple[IntArray, IntArray, BoolArray]:
 
 
 def _labels(n: int, a: IntArray, b: IntArray) -> IntArray:
-    """The lowest node of each node's component, nodes ``0 … n-1`` joined by pairs (a, b).
+    """The lowest node of each node's component, nodes ``0 … n-1`` joined by pairs (a, b):
+    scipy's connected components, each labelled by its lowest node (imported here: keeps
+    ``import geobrep`` fast)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
 
-    Hooking of the higher root onto a lower one (any: the lowest node of a component is never
-    hooked, so it ends as its root), then pointer jumping to the roots: each pass at least
-    halves the number of components that still have a link, so O(log n) passes of numpy work
-    (no Python loop per node or pair).
-    """
-    parent = np.arange(n, dtype=np.int64)
-    while a.size:
-        pa, pb = parent[a], parent[b]
-        moving = pa != pb
-        if not moving.any():
-            break
-        a, b, pa, pb = a[moving], b[moving], pa[moving], pb[moving]
-        parent[np.maximum(pa, pb)] = np.minimum(pa, pb)
-        while True:
-            grand = parent[parent]
-            if np.array_equal(grand, parent):
-                break
-            parent = grand
-    return parent
+    graph = coo_matrix((np.ones(a.shape[0], dtype=np.int8), (a, b)), shape=(n, n))
+    n_components, component = connected_components(graph, directed=False)
+    lowest = np.empty(n_components, dtype=np.int64)
+    lowest[component[::-1]] = np.arange(n - 1, -1, -1, dtype=np.int64)  # the lowest wins
+    return lowest[component]
 
 
-def orientation_flips(faces: ArrayLike, roots: ArrayLike | None = None) -> OrientationFlips:
+def orientation_flips(
+    faces: ArrayLike,
+    roots: ArrayLike | None = None,
+    *,
+    neighbours: tuple[IntArray, IntArray, BoolArray] | None = None,
+) -> OrientationFlips:
     """Flips making each connected piece of ``faces`` agree with its root face.
 
     ``roots`` optionally lists preferred root faces (e.g. a GOCAD TFACE's key triangle); a
-    piece holding none of them is rooted at its lowest face.
+    piece holding none of them is rooted at its lowest face. ``neighbours`` gives the face
+    pairs across manifold edges and whether they run the edge the same way, when the caller
+    already has them (:func:`neighbour_pairs` of the faces' edge table); the result does not
+    depend on their order.
 
     Each face has two states (as is, ``2f``; reversed, ``2f + 1``); a shared manifold edge links
     the states in which the two faces agree. The components of these states are the consistent
@@ -94,7 +101,7 @@ def orientation_flips(faces: ArrayLike, roots: ArrayLike | None = None) -> Orien
     if m == 0:
         empty = np.zeros(0, dtype=np.int64)
         return OrientationFlips(np.zeros(0, dtype=np.bool_), empty, 0, 0)
-    face_a, face_b, same_way = _neighbour_pairs(f)
+    face_a, face_b, same_way = neighbours if neighbours is not None else _neighbour_pairs(f)
     other = same_way.astype(np.int64)  # running the edge the same way: one of them must turn
     state_a = np.concatenate([2 * face_a, 2 * face_a + 1])
     state_b = np.concatenate([2 * face_b + other, 2 * face_b + 1 - other])

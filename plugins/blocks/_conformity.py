@@ -408,10 +408,17 @@ def _along_shared_lines(
     return benign
 
 
-def _crossings(soup: Soup, tol: float) -> list[NonConformity]:
+def _crossings(
+    soup: Soup, tol: float, pairs: tuple[IntArray, IntArray] | None = None
+) -> list[NonConformity]:
+    """Crossings and T-junctions between triangles of different surfaces; ``pairs``: the
+    candidate pairs when the caller's broad phase (a wider margin) already found them."""
     local = soup.local(soup.vertices)
     corners = local[soup.triangles]
-    i, j = overlapping_pairs(corners, soup.triangle_surface, margin=tol)
+    if pairs is None:
+        i, j = overlapping_pairs(corners, soup.triangle_surface, margin=tol)
+    else:
+        i, j = _boxes_within(corners, *pairs, tol)
     if i.size == 0:
         return []
     ti, tj = soup.triangles[i].T, soup.triangles[j].T
@@ -463,23 +470,53 @@ def _allowed_surfaces(soup: Soup, border: IntArray) -> IntArray:
     return np.unique(np.repeat(ring_vertex, count) * n_surfaces + held_surface[rows])
 
 
-def _gaps(soup: Soup, split: PatchSplit, gap_tolerance: float, tol: float) -> list[NonConformity]:
+def _boxes_within(
+    corners: FloatArray, i: IntArray, j: IntArray, margin: float
+) -> tuple[IntArray, IntArray]:
+    """The pairs whose triangles' boxes, grown by ``margin``, overlap."""
+    keep = np.ones(i.shape[0], dtype=np.bool_)
+    for axis in range(3):
+        low, high = corners[:, :, axis].min(axis=1), corners[:, :, axis].max(axis=1)
+        keep &= (low[i] - margin <= high[j] + margin) & (low[j] - margin <= high[i] + margin)
+    return i[keep], j[keep]
+
+
+def _border(soup: Soup, split: PatchSplit) -> tuple[IntArray, IntArray, IntArray]:
+    """The free border edges (B, 2), their vertices and each soup vertex's border surface."""
     free = np.flatnonzero(np.diff(split.offsets) == 1)
-    if free.size == 0 or gap_tolerance <= 0.0:
-        return []
     border = split.edges[free]
     owner = np.full(soup.vertices.shape[0], -1, dtype=np.int64)
     border_surface = soup.triangle_surface[split.incident_triangles[split.offsets[free]]]
     owner[border[:, 0]] = border_surface
     owner[border[:, 1]] = border_surface
-    points = np.unique(border)
+    return border, np.unique(border), owner
+
+
+def _gaps(
+    soup: Soup,
+    split: PatchSplit,
+    gap_tolerance: float,
+    tol: float,
+    pairs: tuple[IntArray, IntArray] | None = None,
+) -> list[NonConformity]:
+    """Gaps (and T-junctions) between free border vertices and other surfaces; ``pairs``:
+    candidate (border point, triangle) pairs when the caller's broad phase found them."""
+    border, points, owner = _border(soup, split)
+    if border.shape[0] == 0 or gap_tolerance <= 0.0:
+        return []
     local = soup.local(soup.vertices)
     corners = local[soup.triangles]
     n_points = points.shape[0]
-    dots = np.repeat(local[points][:, None, :], 3, axis=1)
-    groups = np.concatenate([np.zeros(n_points, np.int64), np.ones(soup.n_triangles, np.int64)])
-    p, t = overlapping_pairs(np.concatenate([dots, corners]), groups, margin=0.5 * gap_tolerance)
-    vertex, t = points[p], t - n_points
+    if pairs is None:
+        dots = np.repeat(local[points][:, None, :], 3, axis=1)
+        groups = np.concatenate([np.zeros(n_points, np.int64), np.ones(soup.n_triangles, np.int64)])
+        p, t = overlapping_pairs(
+            np.concatenate([dots, corners]), groups, margin=0.5 * gap_tolerance
+        )
+        t = t - n_points
+    else:
+        p, t = pairs
+    vertex = points[p]
     n_surfaces = len(soup.surfaces)
     allowed = np.isin(
         vertex * n_surfaces + soup.triangle_surface[t], _allowed_surfaces(soup, border)
@@ -531,8 +568,33 @@ def _hint(soup: Soup, defects: list[NonConformity], gap_tolerance: float) -> str
 
 
 def find_defects(soup: Soup, split: PatchSplit, gap_tolerance: float) -> list[NonConformity]:
-    """Every crossing, T-junction and gap of the soup (what :func:`check_conformity` raises)."""
-    return _crossings(soup, soup.tolerance) + _gaps(soup, split, gap_tolerance, soup.tolerance)
+    """Every crossing, T-junction and gap of the soup (what :func:`check_conformity` raises).
+
+    One broad phase serves both searches: the triangles and the free border points (a group
+    of their own, after every surface) at the wider of the two margins; triangle pairs are
+    then kept where their boxes come within the contact tolerance, point-triangle pairs go to
+    the gap search."""
+    tol = soup.tolerance
+    border, points, _ = _border(soup, split)
+    if border.shape[0] == 0 or gap_tolerance <= 0.0:
+        return _crossings(soup, tol) + _gaps(soup, split, gap_tolerance, tol)
+    local = soup.local(soup.vertices)
+    n = soup.n_triangles
+    dots = np.repeat(local[points][:, None, :], 3, axis=1)
+    corners = np.concatenate([local[soup.triangles], dots])
+    groups = np.concatenate(
+        [soup.triangle_surface, np.full(points.shape[0], len(soup.surfaces), np.int64)]
+    )
+    i, j = overlapping_pairs(corners, groups, margin=max(tol, 0.5 * gap_tolerance))
+    # groups[i] < groups[j]: a border point (the last group) is always j.
+    to_point = j >= n
+    first, second = i[~to_point], j[~to_point]
+    order = np.lexsort((second, first))
+    triangle_pairs = (first[order], second[order])
+    p, t = j[to_point] - n, i[to_point]
+    order = np.lexsort((t, p))
+    crossings = _crossings(soup, tol, triangle_pairs)
+    return crossings + _gaps(soup, split, gap_tolerance, tol, (p[order], t[order]))
 
 
 def check_conformity(soup: Soup, split: PatchSplit, gap_tolerance: float) -> None:

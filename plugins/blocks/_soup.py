@@ -70,12 +70,17 @@ class Soup:
 
 
 def build_soup(
-    surfaces: tuple[Surface, ...], tolerance: float | None, relative_tolerance: float | None
+    surfaces: tuple[Surface, ...],
+    tolerance: float | None,
+    relative_tolerance: float | None,
+    weld: tuple[FloatArray, IntArray] | None = None,
 ) -> Soup:
     """Merge the surfaces' vertices within the tolerance and collect their triangles.
 
     The tolerance is ``tolerance``, else ``relative_tolerance`` × the bounding-box diagonal, else
     (both ``None``) the one the coordinates' precision gives (:func:`.precision.data_tolerance`).
+    ``weld`` is the merge already made by the caller (``merge_close_vertices`` of the surfaces'
+    vertices, concatenated in order, at that tolerance), reused as it is.
 
     >>> import geobrep
     >>> scene = geobrep.datasets.faulted_layer_cake()
@@ -100,7 +105,10 @@ def build_soup(
     elif tolerance is None:
         precision = measure_precision(all_vertices)
         tolerance, rule = data_tolerance(precision, diagonal), "precision"
-    merged, inverse = mesh.merge_close_vertices(all_vertices, tolerance)
+    if weld is not None and weld[1].shape[0] == all_vertices.shape[0]:
+        merged, inverse = weld
+    else:
+        merged, inverse = mesh.merge_close_vertices(all_vertices, tolerance)
 
     triangle_parts: list[IntArray] = []
     surface_parts: list[IntArray] = []

@@ -97,9 +97,15 @@ def surface_nonconformities(
     tolerance: float | None = None,
     gap_tolerance: float | None = None,
     relative_gap_tolerance: float = 1e-3,
+    *,
+    weld: tuple[NDArray[np.float64], NDArray[np.int64]] | None = None,
 ) -> Nonconformities:
-    """Crossings, T-junctions and gaps between ``surfaces``, as the block builder finds them."""
-    soup = build_soup(tuple(surfaces), tolerance, None)
+    """Crossings, T-junctions and gaps between ``surfaces``, as the block builder finds them.
+
+    ``weld`` is the caller's own merge of the surfaces' vertices (``merged points, inverse``
+    of :func:`geobrep.geometry.mesh.merge_close_vertices` over their vertices concatenated in
+    order, at ``tolerance``), reused instead of merging again."""
+    soup = build_soup(tuple(surfaces), tolerance, None, weld)
     gap = gap_tolerance if gap_tolerance is not None else relative_gap_tolerance * soup.diagonal
     if soup.n_triangles == 0:
         return Nonconformities([], soup.tolerance, soup.tolerance_source)

@@ -9,20 +9,60 @@ from numpy.typing import NDArray
 
 from geobrep import Entity, PolyLine, Scene, Surface, TetMesh
 from geobrep.geometry import mesh
+from geobrep.geometry.orientation import neighbour_pairs
 from geobrep.plugins import CheckContext, Defect
 from geobrep.plugins.blocks.precision import data_tolerance, measure_precision
 
 __all__ = [
     "defects",
+    "edge_incidence",
+    "first_copies",
     "label",
     "mesh_entities",
+    "neighbours",
     "tolerance",
     "triangles",
+    "unique_ints",
     "welded",
+    "welded_surfaces",
 ]
 
 IntArray = NDArray[np.int64]
 FloatArray = NDArray[np.float64]
+
+
+def unique_ints(values: IntArray) -> IntArray:
+    """``np.unique`` of integers by one sort (numpy's hashing ``unique`` is many times slower
+    on large arrays)."""
+    ordered = np.sort(np.asarray(values, dtype=np.int64).reshape(-1))
+    if ordered.size == 0:
+        return ordered
+    keep = np.ones(ordered.shape[0], dtype=np.bool_)
+    keep[1:] = ordered[1:] != ordered[:-1]
+    return ordered[keep]
+
+
+def first_copies(rows: IntArray) -> IntArray:
+    """For each row of ``rows`` (K, m) of non-negative integers, the index of the first row equal
+    to it (itself for the first of each kind): rows are packed into one int64 key when they fit,
+    then one stable sort groups them."""
+    rows = np.asarray(rows, dtype=np.int64)
+    k = rows.shape[0]
+    base = int(rows.max()) + 1 if rows.size else 1
+    if rows.ndim != 2 or base ** rows.shape[1] >= 2**62:
+        _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+        return np.asarray(first[inverse.reshape(-1)], dtype=np.int64)
+    key = np.zeros(k, dtype=np.int64)
+    for column in range(rows.shape[1]):
+        key = key * base + rows[:, column]
+    order = np.argsort(key, kind="stable")
+    ordered = key[order]
+    start = np.ones(k, dtype=np.bool_)
+    start[1:] = ordered[1:] != ordered[:-1]
+    group_first = order[np.flatnonzero(start)]
+    result = np.empty(k, dtype=np.int64)
+    result[order] = group_first[np.cumsum(start) - 1]
+    return result
 
 
 def label(entity: Entity) -> str:
@@ -74,19 +114,63 @@ def triangles(surface: Surface, context: CheckContext) -> tuple[IntArray, IntArr
     return result
 
 
+def edge_incidence(
+    surface: Surface, context: CheckContext
+) -> tuple[IntArray, IntArray, IntArray, IntArray]:
+    """The edge table of the surface's triangles (:func:`triangles`), shared by the checks of one
+    inspection: ``(edges, offsets, incident triangles, sides)`` as
+    :func:`geobrep.geometry.mesh.edge_face_incidence` gives them (cached)."""
+    key = f"edges:{id(surface)}"
+    if key not in context.cache:
+        context.cache[key] = mesh.edge_face_incidence(triangles(surface, context)[0])
+    result: tuple[IntArray, IntArray, IntArray, IntArray] = context.cache[key]
+    return result
+
+
+def neighbours(
+    surface: Surface, context: CheckContext
+) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
+    """Triangle pairs across the surface's edges two triangles use, and whether they run the
+    edge the same way (:func:`geobrep.geometry.orientation.neighbour_pairs`, cached)."""
+    key = f"neighbours:{id(surface)}"
+    if key not in context.cache:
+        _, offsets, incident, sides = edge_incidence(surface, context)
+        tris = triangles(surface, context)[0]
+        context.cache[key] = neighbour_pairs(tris, offsets, incident * 3 + sides)
+    result: tuple[IntArray, IntArray, NDArray[np.bool_]] = context.cache[key]
+    return result
+
+
 def welded(scene: Scene, context: CheckContext) -> tuple[FloatArray, list[IntArray]]:
     """Every vertex entity's vertices merged within the tolerance, across entities: the merged
     points and, per entity of :func:`mesh_entities`, the merged index of each vertex (cached)."""
     if "welded" not in context.cache:
-        entities = mesh_entities(scene)
-        tol = tolerance(scene, context)
-        points = np.concatenate([e.vertices for e in entities]) if entities else np.zeros((0, 3))
-        merged, inverse = mesh.merge_close_vertices(points, tol)
-        offsets = np.cumsum([0] + [e.vertices.shape[0] for e in entities])
-        maps = [inverse[offsets[k] : offsets[k + 1]] for k in range(len(entities))]
-        context.cache["welded"] = (merged, maps)
+        context.cache["welded"] = _merged(mesh_entities(scene), tolerance(scene, context))
     result: tuple[FloatArray, list[IntArray]] = context.cache["welded"]
     return result
+
+
+def welded_surfaces(scene: Scene, context: CheckContext) -> tuple[FloatArray, IntArray]:
+    """The surfaces' vertices (concatenated in scene order) merged within the tolerance: the
+    merged points and the merged index of each vertex — :func:`welded` itself when the scene's
+    mesh entities are all surfaces (cached)."""
+    if "welded_surfaces" not in context.cache:
+        entities = mesh_entities(scene)
+        if all(isinstance(e, Surface) for e in entities):
+            points, maps = welded(scene, context)
+        else:
+            points, maps = _merged(list(scene.surfaces), tolerance(scene, context))
+        inverse = np.concatenate(maps) if maps else np.zeros(0, dtype=np.int64)
+        context.cache["welded_surfaces"] = (points, inverse)
+    result: tuple[FloatArray, IntArray] = context.cache["welded_surfaces"]
+    return result
+
+
+def _merged(entities: list[Any], tol: float) -> tuple[FloatArray, list[IntArray]]:
+    points = np.concatenate([e.vertices for e in entities]) if entities else np.zeros((0, 3))
+    merged, inverse = mesh.merge_close_vertices(points, tol)
+    offsets = np.cumsum([0] + [e.vertices.shape[0] for e in entities])
+    return merged, [inverse[offsets[k] : offsets[k + 1]] for k in range(len(entities))]
 
 
 def defects(

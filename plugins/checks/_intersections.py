@@ -18,13 +18,17 @@ from geobrep.plugins.blocks.conformity import (
 )
 from geobrep.plugins.checks._common import (
     defects,
+    edge_incidence,
     label,
     mesh_entities,
+    neighbours,
     tolerance,
     triangles,
     welded,
+    welded_surfaces,
 )
-from geobrep.plugins.checks._pairs import near_pairs
+from geobrep.plugins.checks._embedding import embedded_disk
+from geobrep.plugins.checks._pairs import boxes_overlap, centre_pairs
 
 __all__ = ["contacts", "polyline_intersections", "self_intersections", "surface_intersections"]
 
@@ -42,17 +46,27 @@ def self_intersections(scene: Scene, options: Any, context: CheckContext) -> lis
         tris, source = triangles(surface, context)
         if tris.shape[0] < 2:
             continue
-        merged = maps[position[id(surface)]][tris]
+        welded_index = maps[position[id(surface)]]
+        if options.margin == 0.0 and embedded_disk(
+            surface.vertices,
+            tris,
+            edge_incidence(surface, context),
+            welded_index,
+            neighbours(surface, context)[2],
+        ):
+            continue  # a disk embedded over a plane: no two triangles cross
+        merged = welded_index[tris]
         centre = surface.vertices.mean(axis=0)
         corners = surface.vertices[tris] - centre
-        i, j = near_pairs(corners, options.margin)
+        i, j = centre_pairs(corners, options.margin)
         columns = [np.ascontiguousarray(merged[:, a]) for a in range(3)]
+        theirs = [column[j] for column in columns]
         apart = np.ones(i.shape[0], dtype=np.bool_)
         for a in range(3):
             mine = columns[a][i]
             for b in range(3):
-                apart &= mine != columns[b][j]
-        i, j = i[apart], j[apart]
+                apart &= mine != theirs[b]
+        i, j = boxes_overlap(corners, i[apart], j[apart], options.margin)
         hit = triangles_intersect(corners[i], corners[j], options.margin)
         i, j = i[hit], j[hit]
         swap = source[i] > source[j]
@@ -75,12 +89,13 @@ def self_intersections(scene: Scene, options: Any, context: CheckContext) -> lis
 
 def contacts(scene: Scene, context: CheckContext, options: Any = None) -> Nonconformities:
     """The builder's conformity defects between the scene's surfaces (cached per inspection)."""
-    key = f"contacts:{getattr(options, 'gap_tolerance', None)}"
+    gap = getattr(options, "gap_tolerance", None)
+    relative = getattr(options, "relative_gap_tolerance", 1e-3)
+    key = f"contacts:{gap}:{relative}"
     if key not in context.cache:
-        gap = getattr(options, "gap_tolerance", None)
-        relative = getattr(options, "relative_gap_tolerance", 1e-3)
         tol = tolerance(scene, context)
-        context.cache[key] = surface_nonconformities(scene.surfaces, tol, gap, relative)
+        weld = welded_surfaces(scene, context)
+        context.cache[key] = surface_nonconformities(scene.surfaces, tol, gap, relative, weld=weld)
     result: Nonconformities = context.cache[key]
     return result
 

@@ -10,9 +10,18 @@ from numpy.typing import NDArray
 
 from geobrep import PolyLine, Scene, Surface, TetMesh
 from geobrep.geometry import mesh
-from geobrep.geometry.orientation import orientation_flips
+from geobrep.geometry.orientation import neighbour_pairs, orientation_flips
 from geobrep.plugins import CheckContext, Defect
-from geobrep.plugins.checks._common import defects, mesh_entities, tolerance, triangles
+from geobrep.plugins.checks._common import (
+    defects,
+    edge_incidence,
+    first_copies,
+    mesh_entities,
+    neighbours,
+    tolerance,
+    triangles,
+    unique_ints,
+)
 
 __all__ = [
     "colocated_vertices",
@@ -65,7 +74,7 @@ def _components(entity: Any) -> list[IntArray]:
         return everything
     labels = np.asarray(entity.patch_labels, dtype=np.int64)
     n = np.int64(entity.vertices.shape[0])
-    keys = np.unique(labels[:, None] * n + np.asarray(entity.faces, dtype=np.int64))
+    keys = unique_ints(labels[:, None] * n + np.asarray(entity.faces, dtype=np.int64))
     owner, vertex = keys // n, keys % n
     cuts = np.flatnonzero(np.diff(owner)) + 1
     return [part for part in np.split(vertex, cuts) if part.size]
@@ -73,9 +82,10 @@ def _components(entity: Any) -> list[IntArray]:
 
 def _surface_degenerates(surface: Surface, tol: float, context: CheckContext) -> list[Defect]:
     tris, source = triangles(surface, context)
-    corners = surface.vertices[tris]
-    sides = corners[:, [1, 2, 0]] - corners
-    lengths = np.linalg.norm(sides, axis=2)
+    columns = np.ascontiguousarray(np.asarray(surface.vertices, dtype=np.float64).T)
+    corner = [np.take(columns, tris[:, c], axis=1) for c in range(3)]  # (xyz, T) each
+    sides = [corner[(c + 1) % 3] - corner[c] for c in range(3)]  # side c: corner c to c + 1
+    lengths = np.stack([np.sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) for s in sides], axis=1)
     found: list[Defect] = []
     short = lengths <= tol
     rows, cols = np.nonzero(short)
@@ -91,18 +101,21 @@ def _surface_degenerates(surface: Surface, tol: float, context: CheckContext) ->
             values=np.linalg.norm(np.diff(surface.vertices[ends], axis=1)[:, 0], axis=1),
             message="zero-length edge",
         )
-    doubled = np.linalg.norm(np.cross(sides[:, 0], -sides[:, 2]), axis=1)
-    longest = lengths.max(axis=1)
+    u, v = sides[0], -sides[2]
+    normal = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+    doubled = np.sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2])
+    longest = np.maximum(np.maximum(lengths[:, 0], lengths[:, 1]), lengths[:, 2])
     with np.errstate(divide="ignore", invalid="ignore"):
         height = np.where(longest > 0.0, doubled / longest, 0.0)
-    flat = np.flatnonzero((height <= tol) & ~short.any(axis=1))
+    flat = np.flatnonzero((height <= tol) & ~(short[:, 0] | short[:, 1] | short[:, 2]))
     if flat.size:
+        corners = surface.vertices[tris[flat]]
         found += defects(
             surface,
             "face",
             source[flat],
-            corners[flat].mean(axis=1),
-            points=corners[flat],
+            corners.mean(axis=1),
+            points=corners,
             values=0.5 * doubled[flat],
             message="zero-area triangle (a sliver: its height is within the tolerance)",
         )
@@ -175,10 +188,8 @@ def duplicated_elements(scene: Scene, options: Any, context: CheckContext) -> li
         cells = _elements(entity, context)
         if cells.shape[0] < 2:
             continue
-        key = np.sort(cells, axis=1)
-        _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
-        inverse = inverse.reshape(-1)
-        copies = np.flatnonzero(first[inverse] != np.arange(cells.shape[0]))
+        first = first_copies(np.sort(cells, axis=1))
+        copies = np.flatnonzero(first != np.arange(cells.shape[0]))
         if copies.size == 0:
             continue
         shape = entity.vertices[cells[copies]] if cells.shape[1] in (2, 3) else None
@@ -188,7 +199,7 @@ def duplicated_elements(scene: Scene, options: Any, context: CheckContext) -> li
             copies,
             entity.vertices[cells[copies]].mean(axis=1),
             points=shape,
-            other_ids=first[inverse[copies]],
+            other_ids=first[copies],
             message="duplicate of the element in other_ids",
         )
     return found
@@ -227,10 +238,16 @@ def non_manifold_edges(scene: Scene, options: Any, context: CheckContext) -> lis
     for entity in mesh_entities(scene):
         if isinstance(entity, PolyLine):
             continue
-        faces = _boundary_faces(entity, context)
-        if faces.shape[0] == 0:
-            continue
-        edges, counts = mesh.edge_face_counts(faces)
+        if isinstance(entity, Surface):
+            if entity.n_faces == 0:
+                continue
+            edges, offsets, _, _ = edge_incidence(entity, context)
+            counts = np.diff(offsets)
+        else:
+            faces = _boundary_faces(entity, context)
+            if faces.shape[0] == 0:
+                continue
+            edges, counts = mesh.edge_face_counts(faces)
         bad = edges[counts > 2]
         found += defects(
             entity,
@@ -244,13 +261,16 @@ def non_manifold_edges(scene: Scene, options: Any, context: CheckContext) -> lis
     return found
 
 
-def _fans(faces: IntArray, n_vertices: int) -> tuple[IntArray, IntArray]:
-    """Per vertex: how many faces use it and how many fans (faces joined across edges)."""
+def _fans(
+    faces: IntArray, n_vertices: int, incidence: tuple[IntArray, IntArray, IntArray, IntArray]
+) -> tuple[IntArray, IntArray]:
+    """Per vertex: how many faces use it and how many fans (faces joined across edges), from
+    the faces' edge table ``incidence`` (:func:`~geobrep.geometry.mesh.edge_face_incidence`)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
     m = faces.shape[0]
-    _, offsets, incident, sides = mesh.edge_face_incidence(faces)
+    _, offsets, incident, sides = incidence
     counts = np.diff(offsets)
     # Consecutive faces around an edge join their corners at both of its ends.
     later = np.flatnonzero(np.repeat(counts, counts) > 0)
@@ -271,7 +291,7 @@ def _fans(faces: IntArray, n_vertices: int) -> tuple[IntArray, IntArray]:
     graph = coo_matrix((np.ones(rows.shape[0], np.int8), (rows, cols)), shape=(3 * m, 3 * m))
     _, component = connected_components(graph, directed=False)
     vertex = faces.reshape(-1)
-    pairs = np.unique(vertex.astype(np.int64) * (3 * m) + component)
+    pairs = unique_ints(vertex.astype(np.int64) * (3 * m) + component)
     fans = np.bincount(pairs // (3 * m), minlength=n_vertices)
     uses = np.bincount(vertex, minlength=n_vertices)
     return uses, fans
@@ -284,7 +304,7 @@ def non_manifold_vertices(scene: Scene, options: Any, context: CheckContext) -> 
         tris, _ = triangles(entity, context)
         if tris.shape[0] == 0:
             continue
-        _, fans = _fans(tris, entity.vertices.shape[0])
+        _, fans = _fans(tris, entity.vertices.shape[0], edge_incidence(entity, context))
         bad = np.flatnonzero(fans > 1)
         found += defects(
             entity,
@@ -298,6 +318,25 @@ def non_manifold_vertices(scene: Scene, options: Any, context: CheckContext) -> 
     return found
 
 
+def _patch_neighbours(
+    surface: Surface, tris: IntArray, source: IntArray, context: CheckContext
+) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
+    """Triangle pairs across the edges two triangles *of one patch* use (patches are oriented
+    on their own), from the surface's shared edge table: its sides regrouped by (edge, patch)."""
+    if surface.patch_labels is None or surface.n_patches < 2:
+        return neighbours(surface, context)
+    _, offsets, incident, sides = edge_incidence(surface, context)
+    perm = incident * 3 + sides
+    labels = np.asarray(surface.patch_labels, dtype=np.int64)[source]
+    n_labels = np.int64(labels.max() + 1)
+    edge = np.repeat(np.arange(offsets.shape[0] - 1, dtype=np.int64), np.diff(offsets))
+    key = edge * n_labels + labels[incident]
+    order = np.argsort(key, kind="stable")
+    key = key[order]
+    starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    return neighbour_pairs(tris, np.append(starts, key.shape[0]), perm[order])
+
+
 def inconsistent_orientation(scene: Scene, options: Any, context: CheckContext) -> list[Defect]:
     """Faces wound against their neighbours: per connected piece of each patch, the faces of
     the smaller side (by count) of the orientation split."""
@@ -306,15 +345,9 @@ def inconsistent_orientation(scene: Scene, options: Any, context: CheckContext) 
         tris, source = triangles(surface, context)
         if tris.shape[0] < 2:
             continue
-        labels = (
-            np.asarray(surface.patch_labels, dtype=np.int64)[source]
-            if surface.patch_labels is not None
-            else np.zeros(tris.shape[0], dtype=np.int64)
+        result = orientation_flips(
+            tris, neighbours=_patch_neighbours(surface, tris, source, context)
         )
-        # Patches are oriented on their own: number the vertices per patch.
-        base = np.int64(surface.vertices.shape[0])
-        keyed = tris + labels[:, None] * base
-        result = orientation_flips(keyed)
         flip = result.flip
         n_flipped = np.bincount(result.piece, weights=flip, minlength=result.n_pieces)
         n_faces = np.bincount(result.piece, minlength=result.n_pieces)

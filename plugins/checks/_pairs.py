@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["near_pairs"]
+__all__ = ["boxes_overlap", "centre_pairs", "near_pairs"]
 
 IntArray = NDArray[np.int64]
 FloatArray = NDArray[np.float64]
@@ -44,7 +44,8 @@ def _level_pairs(
             )
             firsts.append(rows_a[found["i"]])
             seconds.append(members[b][found["j"]])
-    return np.concatenate(firsts).astype(np.int64), np.concatenate(seconds).astype(np.int64)
+    first, second = np.concatenate(firsts), np.concatenate(seconds)
+    return first.astype(np.int64, copy=False), second.astype(np.int64, copy=False)
 
 
 def near_pairs(corners: FloatArray, margin: float = 0.0) -> tuple[IntArray, IntArray]:
@@ -57,6 +58,13 @@ def near_pairs(corners: FloatArray, margin: float = 0.0) -> tuple[IntArray, IntA
     >>> sorted(zip(i.tolist(), j.tolist()))
     [(0, 1)]
     """
+    i, j = centre_pairs(corners, margin)
+    return boxes_overlap(corners, i, j, margin)
+
+
+def centre_pairs(corners: FloatArray, margin: float = 0.0) -> tuple[IntArray, IntArray]:
+    """The k-d tree stage of :func:`near_pairs`: pairs whose centroids lie within the sum of
+    their levels' radii (grown by ``margin``), a superset of the pairs whose boxes overlap."""
     n = corners.shape[0]
     if n < 2:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
@@ -66,8 +74,14 @@ def near_pairs(corners: FloatArray, margin: float = 0.0) -> tuple[IntArray, IntA
     level = np.ceil(np.log(np.maximum(radius, unit) / unit) / np.log(_STEP)).astype(np.int64)
     order = np.argsort(level, kind="stable")
     cuts = np.flatnonzero(np.diff(level[order])) + 1
-    members = [rows.astype(np.int64) for rows in np.split(order, cuts)]
-    i, j = _level_pairs(centres, radius, members)
+    members = [rows.astype(np.int64, copy=False) for rows in np.split(order, cuts)]
+    return _level_pairs(centres, radius, members)
+
+
+def boxes_overlap(
+    corners: FloatArray, i: IntArray, j: IntArray, margin: float = 0.0
+) -> tuple[IntArray, IntArray]:
+    """The pairs ``(i, j)`` whose boxes, grown by ``margin``, overlap on all three axes."""
     low = np.ascontiguousarray((corners.min(axis=1) - margin).T)
     high = np.ascontiguousarray((corners.max(axis=1) + margin).T)
     for axis in range(3):
