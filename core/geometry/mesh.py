@@ -28,7 +28,9 @@ __all__ = [
     "is_closed",
     "is_consistently_oriented",
     "merge_close_vertices",
+    "merge_close_vertices_in_parts",
     "non_manifold_edges",
+    "part_vertices",
     "signed_volume",
     "sort_around_axis",
     "surface_area",
@@ -481,6 +483,76 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
     rank[order] = np.arange(order.shape[0], dtype=np.int64)
     representatives = first[order]
     return verts[representatives].copy(), rank[labels].astype(np.int64, copy=False)
+
+
+def part_vertices(faces: ArrayLike, labels: ArrayLike | None, n_vertices: int) -> list[IntArray]:
+    """The vertex sets that are welded (and checked for colocation) on their own: the vertices
+    the faces of each part use (``labels``: a part per face, such as a surface's patch labels),
+    each sorted, in order of the labels — a vertex several parts use is in each; with no labels
+    or a single part, every vertex (``[arange(n_vertices)]``).
+
+    >>> [p.tolist() for p in part_vertices([[0, 1, 2], [1, 2, 3]], [0, 1], 5)]
+    [[0, 1, 2], [1, 2, 3]]
+    >>> [p.tolist() for p in part_vertices([[0, 1, 2]], None, 4)]
+    [[0, 1, 2, 3]]
+    """
+    everything = [np.arange(n_vertices, dtype=np.int64)]
+    if labels is None:
+        return everything
+    part = np.asarray(labels, dtype=np.int64).reshape(-1)
+    if part.size == 0 or int(part.min()) == int(part.max()):
+        return everything
+    f = _as_faces(faces, "part_vertices", n_vertices)
+    n = np.int64(max(n_vertices, 1))
+    keys = np.sort((part[:, None] * n + f).reshape(-1))
+    keep = np.ones(keys.shape[0], dtype=np.bool_)
+    keep[1:] = keys[1:] != keys[:-1]
+    keys = keys[keep]
+    owner, vertex = keys // n, keys % n
+    cuts = np.flatnonzero(np.diff(owner)) + 1
+    return [chunk.astype(np.int64, copy=False) for chunk in np.split(vertex, cuts)]
+
+
+def merge_close_vertices_in_parts(
+    vertices: ArrayLike, parts: list[IntArray], tolerance: float
+) -> tuple[FloatArray, IntArray]:
+    """:func:`merge_close_vertices` where only vertices of one same part merge: vertices within
+    ``tolerance`` of each other (chains included) *inside* a part (``parts``: vertex index
+    arrays, which may share vertices) form a group, groups sharing a vertex are one, and each
+    keeps its lowest-index vertex, groups in order of first appearance. A vertex in no part
+    stays alone. ``(unique_vertices, inverse (N,))``.
+
+    >>> u, inv = merge_close_vertices_in_parts(
+    ...     [[0, 0, 0], [0, 0, 1e-9], [0, 0, 2e-9]], [np.array([0, 1]), np.array([2])], 1e-6
+    ... )
+    >>> inv.tolist()
+    [0, 0, 1]
+    """
+    verts = _as_vertices(vertices, "merge_close_vertices_in_parts")
+    n = verts.shape[0]
+    rows, cols = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)]
+    for members in parts:
+        members = np.asarray(members, dtype=np.int64)
+        if members.size < 2:
+            continue
+        _, inverse = merge_close_vertices(verts[members], tolerance)
+        first = np.full(int(inverse.max()) + 1, members.shape[0], dtype=np.int64)
+        np.minimum.at(first, inverse, np.arange(members.shape[0], dtype=np.int64))
+        joined = np.flatnonzero(first[inverse] != np.arange(members.shape[0]))
+        rows.append(members[joined])
+        cols.append(members[first[inverse[joined]]])
+    from scipy.sparse import coo_matrix  # imported here: keeps `import geobrep` fast
+    from scipy.sparse.csgraph import connected_components
+
+    a, b = np.concatenate(rows), np.concatenate(cols)
+    graph = coo_matrix((np.ones(a.shape[0], dtype=np.int8), (a, b)), shape=(n, n))
+    n_groups, labels = connected_components(graph, directed=False)
+    first_index = np.empty(n_groups, dtype=np.int64)
+    first_index[labels[::-1]] = np.arange(n - 1, -1, -1, dtype=np.int64)  # the lowest wins
+    order = np.argsort(first_index)
+    rank = np.empty(n_groups, dtype=np.int64)
+    rank[order] = np.arange(n_groups, dtype=np.int64)
+    return verts[first_index[order]].copy(), rank[labels].astype(np.int64, copy=False)
 
 
 def sort_around_axis(origin: ArrayLike, axis: ArrayLike, directions: ArrayLike) -> IntArray:

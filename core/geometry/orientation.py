@@ -75,7 +75,7 @@ def _labels(n: int, a: IntArray, b: IntArray) -> IntArray:
     n_components, component = connected_components(graph, directed=False)
     lowest = np.empty(n_components, dtype=np.int64)
     lowest[component[::-1]] = np.arange(n - 1, -1, -1, dtype=np.int64)  # the lowest wins
-    return lowest[component]
+    return np.asarray(lowest[component], dtype=np.int64)
 
 
 def orientation_flips(

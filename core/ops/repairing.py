@@ -2,8 +2,8 @@
 
 Actions, in the order they run (``actions=None`` runs them all):
 
-* ``weld`` — vertices of one surface within the tolerance become one (the lowest index keeps its
-  point data);
+* ``weld`` — vertices of one surface within the tolerance of each other inside one patch become
+  one (the lowest index keeps its point data): the groups ``colocated_vertices`` reports;
 * ``drop_degenerate`` — faces repeating a vertex, or whose height is within the tolerance;
 * ``drop_duplicates`` — faces over the same vertices as an earlier face;
 * ``drop_isolated`` — vertices no face uses;
@@ -122,7 +122,10 @@ def _take(surface: Surface, keep: NDArray[np.bool_], vertices: Any = None) -> Su
 
 
 def _weld(surface: Surface, tol: float) -> tuple[Surface, int]:
-    merged, inverse = mesh.merge_close_vertices(surface.vertices, tol)
+    """Merge what ``colocated_vertices`` reports: vertices within ``tol`` inside one patch (the
+    copies each GOCAD TFACE holds of a border it shares are left alone)."""
+    parts = mesh.part_vertices(surface.faces, surface.patch_labels, surface.vertices.shape[0])
+    merged, inverse = mesh.merge_close_vertices_in_parts(surface.vertices, parts, tol)
     count = surface.vertices.shape[0] - merged.shape[0]
     if count == 0:
         return surface, 0
@@ -348,6 +351,8 @@ def repair(
         clock = time.perf_counter()
         if action == REDERIVE:
             current, step = _rederive(current, signatures, tol)
+            if step.count and "weld" in chosen:
+                current, done = _weld_again(current, done, tol)
         else:
             current, step = _apply(action, current, tol)
         done.append(step)
@@ -361,6 +366,25 @@ def repair(
         tolerance=tol, actions=tuple(done), before=before.counts(), after=after.counts()
     )
     return current, report
+
+
+def _weld_again(
+    current: Scene, done: list[RepairAction], tol: float
+) -> tuple[Scene, list[RepairAction]]:
+    """After patches were re-derived, the copies patches held of a border they no longer split
+    lie inside one patch: weld them too (counted with the first weld)."""
+    current, again = _apply("weld", current, tol)
+    if not again.count:
+        return current, done
+    merged = []
+    for step in done:
+        if step.action == "weld":
+            entities = dict(step.entities)
+            for name, count in again.entities.items():
+                entities[name] = entities.get(name, 0) + count
+            step = step.model_copy(update={"count": step.count + again.count, "entities": entities})
+        merged.append(step)
+    return current, merged
 
 
 def _apply(action: str, current: Scene, tol: float) -> tuple[Scene, RepairAction]:

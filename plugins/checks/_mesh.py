@@ -40,44 +40,41 @@ _TET_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 
 
 def colocated_vertices(scene: Scene, options: Any, context: CheckContext) -> list[Defect]:
-    """Vertices of one entity lying within the tolerance of each other: one defect per group."""
+    """Vertices of one entity lying within the tolerance of each other inside one part (a
+    surface's patch: GOCAD TFACE parts hold their own copies of the vertices they share, and
+    those copies are no defect); groups sharing a vertex are one. One defect per group: the
+    vertices the ``weld`` repair merges into one
+    (:func:`geobrep.geometry.mesh.merge_close_vertices_in_parts`)."""
     tol = tolerance(scene, context)
     found: list[Defect] = []
     for entity in [*mesh_entities(scene), *scene.point_sets]:
-        for members in _components(entity):
-            if members.size < 2:
-                continue
-            _, inverse = mesh.merge_close_vertices(entity.vertices[members], tol)
-            sizes = np.bincount(inverse)
-            shared = np.flatnonzero(sizes[inverse] > 1)
-            if shared.size == 0:
-                continue
-            order = shared[np.argsort(inverse[shared], kind="stable")]
-            for group in np.split(order, np.flatnonzero(np.diff(inverse[order])) + 1):
-                ids = members[np.sort(group)]
-                found += defects(
-                    entity,
-                    "vertex",
-                    ids[None, :],
-                    entity.vertices[ids[0]][None],
-                    points=entity.vertices[ids[:1]][None],
-                    message=f"{ids.size} vertices within {tol:.3g}",
-                )
+        n = entity.vertices.shape[0]
+        if n < 2:
+            continue
+        _, inverse = mesh.merge_close_vertices_in_parts(entity.vertices, _parts(entity), tol)
+        sizes = np.bincount(inverse)
+        shared = np.flatnonzero(sizes[inverse] > 1)
+        if shared.size == 0:
+            continue
+        order = shared[np.argsort(inverse[shared], kind="stable")]
+        for group in np.split(order, np.flatnonzero(np.diff(inverse[order])) + 1):
+            ids = np.sort(group)
+            found += defects(
+                entity,
+                "vertex",
+                ids[None, :],
+                entity.vertices[ids[0]][None],
+                points=entity.vertices[ids[:1]][None],
+                message=f"{ids.size} vertices within {tol:.3g}",
+            )
     return found
 
 
-def _components(entity: Any) -> list[IntArray]:
-    """The vertex sets checked on their own: each patch of a surface (GOCAD TFACE parts hold
-    their own copies of the vertices they share), else the whole entity."""
-    everything = [np.arange(entity.vertices.shape[0])]
-    if not isinstance(entity, Surface) or entity.patch_labels is None or entity.n_patches < 2:
-        return everything
-    labels = np.asarray(entity.patch_labels, dtype=np.int64)
-    n = np.int64(entity.vertices.shape[0])
-    keys = unique_ints(labels[:, None] * n + np.asarray(entity.faces, dtype=np.int64))
-    owner, vertex = keys // n, keys % n
-    cuts = np.flatnonzero(np.diff(owner)) + 1
-    return [part for part in np.split(vertex, cuts) if part.size]
+def _parts(entity: Any) -> list[IntArray]:
+    """The vertex sets welded on their own: each patch of a surface, else the whole entity."""
+    if isinstance(entity, Surface):
+        return mesh.part_vertices(entity.faces, entity.patch_labels, entity.vertices.shape[0])
+    return [np.arange(entity.vertices.shape[0], dtype=np.int64)]
 
 
 def _surface_degenerates(surface: Surface, tol: float, context: CheckContext) -> list[Defect]:

@@ -20,9 +20,11 @@ FACES = np.array(  # outward
 TOP = np.array([10, 11])
 
 
-def _split_top_model() -> Scene:
+def _split_top_model(duplicated: bool = False) -> Scene:
     """A cube block whose top is a patch of its own over its own copies of the vertices (as a
-    GOCAD TFACE holds them): two patches whose borders a weld joins into one edge chain."""
+    GOCAD TFACE holds them: no defect). ``duplicated``: the second top triangle also holds its
+    own copies of the two vertices it shares with the first, inside the top patch (a defect:
+    colocated vertices of one patch), which a weld joins."""
     box = Surface(
         vertices=CUBE, faces=FACES, name="box", point_data={"depth": -CUBE[:, 2]},
         cell_data={"unit": np.arange(12)},
@@ -30,10 +32,19 @@ def _split_top_model() -> Scene:
     built = geobrep.build_blocks(Scene(entities=[box]))
     box = built.surfaces[0]
     faces = np.asarray(box.faces).copy()
+    n = box.n_vertices
     top_vertices = np.unique(faces[TOP])
-    copies = np.arange(box.n_vertices, box.n_vertices + top_vertices.size)
+    copies = np.arange(n, n + top_vertices.size)
     renumber = dict(zip(top_vertices.tolist(), copies.tolist(), strict=True))
     faces[TOP] = np.vectorize(renumber.get)(faces[TOP])
+    sources = top_vertices.tolist()
+    if duplicated:
+        second = faces[TOP[1]].copy()
+        for vertex in np.intersect1d(faces[TOP[0]], faces[TOP[1]]).tolist():
+            second[second == vertex] = n + len(sources)
+            sources.append(sources[vertex - n])
+        faces[TOP[1]] = second
+    top_vertices = np.asarray(sources)
     labels = np.zeros(12, dtype=np.int64)
     labels[TOP] = 1
     split = box.replace(
@@ -55,11 +66,24 @@ def _split_top_model() -> Scene:
     return Scene(entities=[split, *blocks], topology=topology)
 
 
-def test_a_weld_joining_two_patches_borders_rederives_patches_and_blocks() -> None:
+def test_copies_each_patch_holds_of_a_shared_border_are_no_defect() -> None:
     scene = _split_top_model()
     assert scene.surfaces[0].n_vertices == 12
+    assert geobrep.inspect(scene).ok, geobrep.inspect(scene).table()
     repaired, report = geobrep.repair(scene)
-    assert next(a.count for a in report.actions if a.action == "weld") == 4
+    assert report.total == 0
+    assert repaired.surfaces[0].n_vertices == 12
+
+
+def test_a_weld_joining_two_patches_borders_rederives_patches_and_blocks() -> None:
+    scene = _split_top_model(duplicated=True)
+    assert scene.surfaces[0].n_vertices == 14
+    before = geobrep.inspect(scene, ["colocated_vertices"]).section("colocated_vertices")
+    assert before.count == 2  # the two copies inside the top patch, nothing across patches
+    assert all(len(d.ids) == 2 and min(d.ids) >= 8 for d in before.defects)
+    repaired, report = geobrep.repair(scene)
+    # 2 inside the top patch; once the patches are one, the 4 copies the top held of the sides
+    assert next(a.count for a in report.actions if a.action == "weld") == 6
     step = next(a for a in report.actions if a.action == "rederive_patches")
     assert step.count == 1
     assert any("2 patch(es) -> 1" in n for n in step.notes)
