@@ -9,8 +9,12 @@ Actions, in the order they run (``actions=None`` runs them all):
 * ``drop_isolated`` — vertices no face uses;
 * ``split_t_junctions`` — a vertex of one surface lying on another's face or edge is inserted
   there (the edge, or the face, is split), so that the two become conformal;
-* ``orient`` — the faces of each patch agree with its majority;
+* ``orient`` — the faces of each patch agree with its majority; inverted tets are turned;
 * ``orient_blocks`` — each block's sides orient its boundary outward (positive volume).
+
+The mesh actions also mend polylines and tet meshes (:mod:`geobrep.ops._repair_cells`: welded
+vertices, zero-length segments collapsed, flat and duplicated tets or duplicated segments
+dropped, unused vertices dropped, inverted tets turned).
 
 Properties (point and cell data), ids, names, kinds, patch labels and the topology are kept;
 face data follow their faces, a vertex inserted on an edge interpolates its point data.
@@ -38,6 +42,7 @@ from geobrep.model.orientation import orient_blocks, orient_patches
 from geobrep.model.properties import Property
 from geobrep.model.scene import Scene
 from geobrep.ops._rederive import connectivity, rederive_patches
+from geobrep.ops._repair_cells import CELL_ACTIONS
 from geobrep.ops.inspection import Progress, _as_inspected_scene, _checked_tolerance, inspect
 
 __all__ = ["ACTIONS", "RepairAction", "RepairReport", "repair"]
@@ -53,14 +58,14 @@ ACTIONS = (
     "orient",
     "orient_blocks",
 )
-#: The check whose defects each action mends (inspected before and after).
-ADDRESSES = {
+#: The check (or checks) whose defects each action mends (inspected before and after).
+ADDRESSES: dict[str, str | tuple[str, ...]] = {
     "weld": "colocated_vertices",
     "drop_degenerate": "degenerate_elements",
     "drop_duplicates": "duplicated_elements",
     "drop_isolated": "isolated_vertices",
     "split_t_junctions": "t_junctions",
-    "orient": "inconsistent_orientation",
+    "orient": ("inconsistent_orientation", "inverted_tets"),
     "orient_blocks": "region_sides",
 }
 _ROUNDS = 4
@@ -304,6 +309,11 @@ def _split_t_junctions(scene: Scene, tol: float) -> tuple[Scene, int, list[str]]
     return scene, count, notes
 
 
+def _addressed(action: str) -> tuple[str, ...]:
+    checks = ADDRESSES[action]
+    return (checks,) if isinstance(checks, str) else checks
+
+
 def _chosen_actions(actions: str | Iterable[str] | None) -> list[str]:
     if actions is None:
         return list(ACTIONS)
@@ -336,7 +346,7 @@ def repair(
     and the inspection after (steps ``inspect before``, the step names, ``inspect after``)."""
     source = _as_inspected_scene(scene)
     chosen = _chosen_actions(actions)
-    checks = [ADDRESSES[a] for a in chosen]
+    checks = [c for a in chosen for c in _addressed(a)]
     steps, clock = len(chosen) + 3, time.perf_counter()
     before = inspect(source, checks, _checked_tolerance(tolerance), max_listed=0)
     if progress is not None:
@@ -393,11 +403,15 @@ def _apply(action: str, current: Scene, tol: float) -> tuple[Scene, RepairAction
     per_entity: dict[str, int] = {}
     if action in _PER_SURFACE:
         replaced: dict[int, Entity] = {}
-        for surface in current.surfaces:
-            fixed, count = _PER_SURFACE[action](surface, tol)
+        for entity in current.entities:
+            function = _PER_SURFACE[action] if isinstance(entity, Surface) else None
+            function = function or CELL_ACTIONS.get(action, {}).get(type(entity))
+            if function is None:
+                continue
+            fixed, count = function(entity, tol)
             if count:
-                replaced[int(surface.id or 0)] = fixed
-                per_entity[surface.name or surface.label] = count
+                replaced[int(entity.id or 0)] = fixed
+                per_entity[entity.name or entity.label] = count
         current = current.replace(
             entities=[replaced.get(int(e.id or 0), e) for e in current.entities]
         )

@@ -50,7 +50,7 @@ BUILTIN_CHECKS: tuple[tuple[str, str, str, str, str | None, str | None], ...] = 
         None,
         "orient",
     ),
-    ("inverted_tets", "negative elements", "_mesh", "Inverted tets", None, None),
+    ("inverted_tets", "negative elements", "_mesh", "Inverted tets", None, "orient"),
     (
         "self_intersections",
         "intersections",
