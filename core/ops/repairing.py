@@ -337,10 +337,11 @@ def repair(
     """Mend the defects ``actions`` address (default: all of :data:`ACTIONS`), at ``tolerance``
     (default: the one :func:`geobrep.inspect` derives from the data's precision).
 
-    Where the mesh actions changed a surface's connectivity (a weld joining two patches'
-    borders, an edge split at a T-junction), patches, topology and blocks are re-derived by the
+    Where the mesh actions changed a surface's connectivity (a weld closing a seam inside a
+    patch, an edge split at a T-junction), patches, topology and blocks are re-derived by the
     block builder before orienting (step ``rederive_patches``, see :mod:`geobrep.ops._rederive`),
-    keeping properties, ids and names.
+    keeping properties, ids and names; copies of a border that re-derived patches now hold
+    inside one patch are welded then (counted with ``weld``).
 
     ``progress(step, done, total, seconds)`` is called after the inspection before, each step
     and the inspection after (steps ``inspect before``, the step names, ``inspect after``)."""
