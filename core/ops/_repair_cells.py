@@ -75,7 +75,7 @@ def _drop_isolated(entity: PolyLine | TetMesh, tol: float) -> tuple[Any, int]:
 def _rebuild(line: PolyLine, keep: BoolArray) -> PolyLine:
     """``line`` with only the segments ``keep`` (in segment order): each part becomes the runs
     of its kept segments (a closed part with all kept stays closed)."""
-    parts: list[IntArray] = []
+    parts: list[NDArray[Any]] = []
     closed: list[bool] = []
     kept_segments: list[IntArray] = []
     segment = 0
@@ -120,7 +120,7 @@ def _collapse_repeats(line: PolyLine) -> tuple[PolyLine, int]:
     count = int(repeated.sum())
     if count == 0:
         return line, 0
-    parts: list[IntArray] = []
+    parts: list[NDArray[Any]] = []
     closed: list[bool] = []
     kept: list[IntArray] = []
     segment = 0

@@ -28,7 +28,7 @@ face data follow their faces, a vertex inserted on an edge interpolates its poin
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
@@ -405,7 +405,9 @@ def _apply(action: str, current: Scene, tol: float) -> tuple[Scene, RepairAction
     if action in _PER_SURFACE:
         replaced: dict[int, Entity] = {}
         for entity in current.entities:
-            function = _PER_SURFACE[action] if isinstance(entity, Surface) else None
+            function: Callable[[Any, float], tuple[Any, int]] | None = (
+                _PER_SURFACE[action] if isinstance(entity, Surface) else None
+            )
             function = function or CELL_ACTIONS.get(action, {}).get(type(entity))
             if function is None:
                 continue
