@@ -214,10 +214,15 @@ def remove_stale_temporaries(final: Path) -> list[Path]:
     Best effort: a temporary that cannot be removed is left for ``geobrep clean``.
     """
     prefix = f"{final.stem}.tmp-"
+    try:  # names only, filtered in one pass: a batch writes thousands of files to one folder
+        names = os.listdir(final.parent)
+    except OSError:
+        return []
     removed: list[Path] = []
-    for path in _entries(final.parent, recursive=False):
-        if not path.name.lstrip(".").startswith(prefix):
+    for name in names:
+        if not (name.startswith(".") and ".tmp-" in name and name.lstrip(".").startswith(prefix)):
             continue
+        path = final.parent / name
         temporary = _examine(path)
         if temporary is not None and temporary.stale and remove(temporary):
             removed.append(path)
