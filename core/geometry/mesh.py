@@ -291,7 +291,7 @@ def signed_volume(vertices: ArrayLike, faces: ArrayLike) -> float:
     if f.shape[0] == 0:
         return 0.0
     columns = _columns(verts, 0.5 * np.add(*column_extremes(verts)))
-    tris, _ = triangulate(f)
+    tris = f if f.shape[1] == 3 else triangulate(f)[0]  # only read: no copy of triangles
     a = _gather(columns, tris[:, 0])
     cross = _cross(_gather(columns, tris[:, 1]), _gather(columns, tris[:, 2]))
     return float(np.einsum("ij,ij->", a, cross)) / 6.0

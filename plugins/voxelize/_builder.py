@@ -194,6 +194,7 @@ def build_octree(scene: Scene, options: VoxelizeOptions) -> LinearOctree:
         merged = Leaves(merged.codes, merged.levels, np.zeros_like(merged.bodies))
     merged = merge_full_siblings(merged, depth)
     _warn(reports, options.method)
+    del grid, parts  # the reports below gather the triangles' corners again: room for them
 
     labels_of_bodies = np.array([body.label for body in bodies], dtype=np.int64)
     metadata: dict[str, Any] = {

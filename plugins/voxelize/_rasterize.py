@@ -28,6 +28,8 @@ __all__ = ["RayCrossings", "fixed_point_bits", "ray_crossings"]
 
 #: Candidate (triangle, pixel) pairs evaluated at once; bounds the temporary memory (~100 B each).
 CHUNK_CANDIDATES = 1 << 20
+#: Triangles prepared at once; bounds the per-triangle data (~30 numbers of 8 bytes each).
+TRIANGLE_CHUNK = 1 << 17
 #: Fixed-point coordinates stay below ``2**LATTICE_BITS`` so edge functions fit int64 exactly.
 LATTICE_BITS = 29
 #: Triangles whose pixel box is at most this many pixels on a side are tested as regular blocks.
@@ -204,19 +206,23 @@ def ray_crossings(
     bits = fixed_point_bits(max_abs, n)
     half = 1 << (bits - 1)
     lattice = np.rint(uv * float(1 << bits)).astype(np.int64)
-    tri = _prepare(
-        np.ascontiguousarray(lattice[:, 0]),
-        np.ascontiguousarray(lattice[:, 1]),
-        triangles,
-        np.ascontiguousarray(grid_vertices[:, axis]),
-        half,
-        n,
-    )
-
-    boxed = (tri.width_u > 0) & (tri.width_v > 0)
-    small = (tri.width_u <= SMALL_BOX) & (tri.width_v <= SMALL_BOX) & boxed
-    pieces = _small_box_crossings(tri, small, half, n)
-    pieces += _large_box_crossings(tri, np.flatnonzero(~small & boxed), half, n)
+    lattice_u, lattice_v = np.ascontiguousarray(lattice[:, 0]), np.ascontiguousarray(lattice[:, 1])
+    del lattice
+    depth_of_vertex = np.ascontiguousarray(grid_vertices[:, axis])
+    # Triangles are prepared a chunk at a time (the per-triangle data is ~30 arrays); the
+    # pieces are put together in the order one pass over all triangles gives.
+    by_shape: dict[int, list[_Crossings]] = {}
+    large_pieces: list[_Crossings] = []
+    for start in range(0, triangles.shape[0], TRIANGLE_CHUNK):
+        chunk = triangles[start : start + TRIANGLE_CHUNK]
+        tri = _prepare(lattice_u, lattice_v, chunk, depth_of_vertex, half, n)
+        boxed = (tri.width_u > 0) & (tri.width_v > 0)
+        small = (tri.width_u <= SMALL_BOX) & (tri.width_v <= SMALL_BOX) & boxed
+        for shape, piece in _small_box_crossings(tri, small, half, n).items():
+            by_shape.setdefault(shape, []).append(piece)
+        large_pieces += _large_box_crossings(tri, np.flatnonzero(~small & boxed), half, n)
+        del tri, boxed, small
+    pieces = [piece for shape in sorted(by_shape) for piece in by_shape[shape]] + large_pieces
     if not pieces:
         return RayCrossings(
             axis, n, np.zeros(0, np.int64), np.zeros(0, np.float64), np.zeros(0, np.bool_)
@@ -232,9 +238,10 @@ def ray_crossings(
 
 def _small_box_crossings(
     tri: _Triangles, small: NDArray[np.bool_], half: int, n: int
-) -> list[_Crossings]:
-    """Triangles with small pixel boxes (most of a fine mesh): one regular block per box shape."""
-    pieces: list[_Crossings] = []
+) -> dict[int, _Crossings]:
+    """Triangles with small pixel boxes (most of a fine mesh): one regular block per box shape,
+    by box shape (in increasing order)."""
+    pieces: dict[int, _Crossings] = {}
     shape_key = np.where(small, (tri.width_u - 1) * SMALL_BOX + tri.width_v - 1, -1)
     for wu in range(1, SMALL_BOX + 1):
         for wv in range(1, SMALL_BOX + 1):
@@ -245,7 +252,7 @@ def _small_box_crossings(
             dv = np.tile(np.arange(wv), wu)[None, :]
             p = np.take(tri.first_u, rows)[:, None] + du
             q = np.take(tri.first_v, rows)[:, None] + dv
-            pieces.append(_covered(tri, rows, p, q, half, n))
+            pieces[(wu - 1) * SMALL_BOX + wv - 1] = _covered(tri, rows, p, q, half, n)
     return pieces
 
 
