@@ -16,7 +16,16 @@ from hypothesis import strategies as st
 from test_formats_grdecl import faulted_grid
 
 import geobrep
-from geobrep import Property, RegularGrid, Scene, StructuredGrid, Well, WellMarker, WellZone
+from geobrep import (
+    Property,
+    RegularGrid,
+    Scene,
+    StructuredGrid,
+    Well,
+    WellLog,
+    WellMarker,
+    WellZone,
+)
 from geobrep.geometry.trajectory import minimum_curvature
 
 
@@ -49,6 +58,13 @@ def _well() -> Well:
     )
 
 
+def _logs() -> dict[str, WellLog]:
+    md = np.linspace(100.0, 110.0, 21)
+    gr = np.cos(md) * 40.0 + 60.0
+    gr[3] = -999.25
+    return {"GR": WellLog(md=md, values=gr, unit="API", no_data_value=-999.25)}
+
+
 def _sgrid() -> StructuredGrid:
     k, j, i = np.meshgrid(np.arange(3), np.arange(3), np.arange(4), indexing="ij")
     points = np.stack([i * 10.0 + j, j * 20.0, k * 5.0 + 0.5 * i], axis=-1).reshape(-1, 3)
@@ -73,6 +89,7 @@ def _files(folder: Path) -> dict[str, list[Path]]:
         grdecl = geobrep.write(faulted_grid(), folder / "g.grdecl")
         dev = geobrep.write(_well().replace(markers=(), zones=()), folder / "w.dev")
         sg = geobrep.write(_sgrid(), folder / "s.sg")
+        las = geobrep.write(_well().replace(logs=_logs()), folder / "w.las")
     sides = sorted(folder.glob("s__*@@"))
     return {
         "v.vo": [vo, folder / "v__p@@"],
@@ -80,6 +97,7 @@ def _files(folder: Path) -> dict[str, list[Path]]:
         "w.wl": [wl],
         "g.grdecl": [grdecl],
         "w.dev": [dev],
+        "w.las": [las],
     }
 
 
@@ -129,13 +147,12 @@ def _read_or_error(path: Path) -> geobrep.FormatError | None:
 
 
 @settings(
-    derandomize=True,
     max_examples=300,
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
 @given(
-    st.sampled_from(["v.vo", "s.sg", "w.wl", "g.grdecl", "w.dev"]),
+    st.sampled_from(["v.vo", "s.sg", "w.wl", "g.grdecl", "w.dev", "w.las"]),
     st.integers(0, 4),
     st.lists(mutation, min_size=1, max_size=4),
 )

@@ -200,7 +200,6 @@ def dem_bytes(tmp_path_factory: pytest.TempPathFactory) -> bytes:
 
 
 @settings(
-    derandomize=True,
     max_examples=150,
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],

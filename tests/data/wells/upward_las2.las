@@ -1,0 +1,22 @@
+~VERSION INFORMATION
+ VERS.                 2.0 :   CWLS LOG ASCII STANDARD -VERSION 2.0
+ WRAP.                  NO :   ONE LINE PER DEPTH STEP
+~WELL INFORMATION
+ STRT.M             1670.0 :
+ STOP.M             1669.5 :
+ STEP.M               -0.25 :
+ NULL.             -999.25 :
+ WELL.        ANY ET AL 12-34-12-34 :  WELL
+ X   .M          451234.5 : X
+ Y   .M         6701234.0 : Y
+ EKB .M             123.4 : KB elevation
+~CURVE INFORMATION
+ DEPT.M                    :  1  DEPTH
+ DT  .US/M      60 520 32 00 :  2  SONIC TRANSIT TIME
+ RHOB.K/M3      45 350 01 00 :  3  BULK DENSITY
+~A  DEPTH     DT    RHOB
+1670.000   123.450 2550.000
+1669.875   123.450 -999.25
+1669.750   123.450 2550.000
+1669.625   -999.25 2550.000
+1669.500   123.450 2550.000
