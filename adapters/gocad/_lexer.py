@@ -1,7 +1,7 @@
 """Split a GOCAD ASCII file into lines and bulk runs of numeric element lines.
 
 GOCAD files are keyword-first text. Most of a large file is made of runs of ``VRTX``,
-``PVRTX``, ``TRGL``, ``SEG`` and ``TETRA`` lines; :func:`scan` finds those runs with numpy
+``PVRTX``, ``ATOM``, ``TRGL``, ``SEG`` and ``TETRA`` lines; :func:`scan` finds those runs with numpy
 (one look at the first bytes of every line) so that a reader converts each run with one bulk
 parse (:func:`parse_run`) and walks only the few remaining lines in Python.
 """
@@ -24,7 +24,7 @@ from geobrep.errors import FormatError
 __all__ = ["BULK_KEYWORDS", "ORJSON", "Line", "Run", "Source", "parse_run", "scan", "split_tokens"]
 
 #: Keywords whose lines are parsed in bulk (the keyword, then numbers).
-BULK_KEYWORDS: tuple[str, ...] = ("VRTX", "PVRTX", "TRGL", "SEG", "TETRA")
+BULK_KEYWORDS: tuple[str, ...] = ("VRTX", "PVRTX", "TRGL", "SEG", "TETRA", "ATOM")
 
 
 @dataclass(frozen=True)

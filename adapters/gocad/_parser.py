@@ -587,6 +587,8 @@ class _Parser:
         part: int,
         solid: _SolidDraft,
     ) -> int:
+        if run.keyword == "ATOM":
+            return self._atom_run(obj, run, vertices, cells, part, solid)
         if run.keyword in ("VRTX", "PVRTX"):
             part = self._ensure_part(obj, part, vertices, run.first)
             width = 4 + (obj.point_header.n_values if run.keyword == "PVRTX" else 0)
@@ -637,6 +639,34 @@ class _Parser:
             ),
             part,
             run.first,
+        )
+        return part
+
+    def _atom_run(
+        self,
+        obj: GocadObject,
+        run: Run,
+        vertices: VertexTable,
+        cells: CellTable | None,
+        part: int,
+        solid: _SolidDraft,
+    ) -> int:
+        """A run of ``ATOM <new id> <id>`` lines in one bulk parse (line by line when it holds
+        anything else, such as flags)."""
+        part = self._ensure_part(obj, part, vertices, run.first)
+        try:
+            if run.count < 2:
+                raise BulkParseError
+            block = parse_run(self.source, run, integer=True)
+            if block.shape[1] != 2:
+                raise BulkParseError
+        except BulkParseError:
+            self._run_lines(obj, run, vertices, cells, part, solid)
+            return part
+        if obj.point_header.n_values:
+            self._check_absent(obj, vertices, run.count, run.keyword, run.first)
+        vertices.add_atoms(
+            np.ascontiguousarray(block[:, 0]), np.ascontiguousarray(block[:, 1]), run.first
         )
         return part
 

@@ -88,6 +88,22 @@ class VertexTable:
             )
         )
 
+    def add_atoms(self, ids: IntArray, refs: IntArray, first_line: int) -> None:
+        """A bulk run of ATOM lines (new ids at the positions of earlier ones, values
+        inherited)."""
+        self._flush()
+        n = ids.shape[0]
+        self._chunks.append(
+            (
+                ids,
+                np.full((n, 3), np.nan),
+                refs,
+                np.full((n, self.n_values), np.nan),
+                np.full(n, _INHERIT if self.n_values else 0, dtype=np.int8),
+                np.arange(first_line, first_line + n, dtype=np.int64),
+            )
+        )
+
     def _flush(self) -> None:
         pending = self._pending
         if not pending.ids:

@@ -31,7 +31,7 @@ import numpy as np
 
 from geobrep.errors import TopologyError
 from geobrep.geometry import mesh
-from geobrep.geometry.arrays import BoolArray
+from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.geometry.orientation import orientation_flips
 from geobrep.model._shells import Shell, block_shells
 from geobrep.model.entities import Block, PatchSide, Surface
@@ -68,6 +68,8 @@ def orient_patches(
         for label, face in (reference_faces or {}).items()
         if face is not None and 0 <= face < faces.shape[0] and labels[face] == label
     ]
+    if mesh.is_consistently_oriented(separate):  # the usual case: nothing to turn
+        return surface, {}
     result = orientation_flips(separate, roots or None)
     flip = result.flip.copy()
     # Pieces without the reference face follow their majority.
@@ -106,12 +108,11 @@ class BlockOrientation:
         return bool(self.reversed_patches)
 
 
-def _shell_orientation(block: Block, shell: Shell | Surface) -> BlockOrientation:
-    """The orientation of ``block`` from its boundary (:meth:`Scene.block_mesh`)."""
-    faces = shell.faces
-    labels = np.asarray(shell.patch_labels, dtype=np.int64)
-    internal = block.internal_patches
-    boundary_sides = [s for s in block.sides if s.patch not in internal]
+def _shell_flips(block: Block, faces: IntArray, areas: FloatArray) -> BoolArray:
+    """The faces of a block's shell to turn so that it runs one way (within each connected
+    piece, the side of larger area keeps its sign); none when it already does."""
+    if mesh.is_consistently_oriented(faces):  # no directed edge twice: every piece agrees
+        return np.zeros(faces.shape[0], dtype=np.bool_)
     result = orientation_flips(faces)
     if result.n_conflicts:
         raise TopologyError(
@@ -119,11 +120,20 @@ def _shell_orientation(block: Block, shell: Shell | Surface) -> BlockOrientation
             "where neighbouring triangles disagree whichever way they turn)"
         )
     flip = result.flip.copy()
-    areas = mesh.face_areas(shell.vertices, faces)
-    # Within each piece, the side of larger area keeps its sign.
     flipped_area = np.bincount(result.piece, weights=areas * flip, minlength=result.n_pieces)
     total_area = np.bincount(result.piece, weights=areas, minlength=result.n_pieces)
     flip ^= (flipped_area * 2 > total_area)[result.piece]
+    return flip
+
+
+def _shell_orientation(block: Block, shell: Shell | Surface) -> BlockOrientation:
+    """The orientation of ``block`` from its boundary (:meth:`Scene.block_mesh`)."""
+    faces: IntArray = np.asarray(shell.faces, dtype=np.int64)
+    labels = np.asarray(shell.patch_labels, dtype=np.int64)
+    internal = block.internal_patches
+    boundary_sides = [s for s in block.sides if s.patch not in internal]
+    areas = mesh.face_areas(shell.vertices, faces)
+    flip = _shell_flips(block, faces, areas)
     n_sides = len(boundary_sides)
     flipped_count = np.bincount(labels, weights=flip, minlength=n_sides)
     face_count = np.bincount(labels, minlength=n_sides)
