@@ -34,6 +34,7 @@ FUNCTIONS = {
     "check": (geobrep.inspect, {}),
     "repair": (geobrep.repair, {}),
     "convert": (geobrep.convert, {"format": "to", "options": "write_options"}),
+    "map_products": (geobrep.map_products, {}),
 }
 #: Keys that say what a step does with the scene, not how the function works.
 STEP_ONLY = {
@@ -54,6 +55,7 @@ DERIVED = {
     "check",
     "repair",
     "convert",
+    "map_products",
 }
 
 

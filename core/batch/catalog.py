@@ -21,6 +21,7 @@ SUMMARIES: dict[str, str] = {
     "voxelize": "linear octree of the closed bodies of a model",
     "check": "inspect models: defects with their locations (exit 3 when found)",
     "repair": "mend a model: weld, drop degenerate elements, split T-junctions, orient",
+    "map_products": "map products: block outlines, top traces and sections as GIS layers",
     "convert": "convert files between formats",
     "render": "render a picture of a model (PNG, off-screen)",
     "view": "write a model as one offline HTML page to look at in a browser",

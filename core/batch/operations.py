@@ -27,6 +27,7 @@ from geobrep.batch.pipeline import (
     ClipStep,
     ConvertStep,
     FitStep,
+    MapProductsStep,
     RenderStep,
     RepairStep,
     ReprojectStep,
@@ -44,6 +45,7 @@ __all__ = [
     "builtin_operations",
     "docs_tables",
     "fit_inputs",
+    "map_scene_products",
     "operations",
     "update_docs",
 ]
@@ -155,6 +157,22 @@ def _repair(scene: Scene, step: RepairStep) -> Scene:
     return repair(scene, step.actions, step.tolerance)[0]
 
 
+def map_scene_products(scene: Scene, step: MapProductsStep) -> Scene:
+    """The map products of ``scene`` (:func:`geobrep.map_products`) the step's options give."""
+    from geobrep.geometry import Plane
+    from geobrep.gis.map_products import map_products
+
+    return map_products(
+        scene,
+        top=step.top,
+        section_levels=step.section_levels,
+        section_planes=[Plane(*plane) for plane in step.section_planes],
+        elevation=step.elevation,
+        with_section_lines=step.with_section_lines,
+        section_coordinates=step.section_coordinates,
+    )
+
+
 def as_written(scene: Scene, step: Any) -> Scene:
     """The scene a step that writes a file writes: ``scene`` without the reader's list of
     what it skipped (that describes the source, not the file written)."""
@@ -238,6 +256,14 @@ def builtin_operations() -> list[OperationSpec]:
             options=RepairStep,
             function=_repair,
             writes="the repaired scene (properties, ids and names kept)",
+        ),
+        OperationSpec(
+            name="map_products",
+            summary=SUMMARIES["map_products"],
+            options=MapProductsStep,
+            function=map_scene_products,
+            command="map",
+            writes="the block outlines, top traces and sections (layers), in the model's CRS",
         ),
         OperationSpec(
             name="convert",

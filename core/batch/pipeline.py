@@ -78,6 +78,7 @@ __all__ = [
     "ClipStep",
     "ConvertStep",
     "FitStep",
+    "MapProductsStep",
     "OperationStep",
     "OutputStep",
     "Pipeline",
@@ -391,6 +392,48 @@ class RepairStep(StepOptions):
     """weld/contact tolerance (default: from the data's precision)"""
 
 
+def _top(text: str) -> str | int | None:
+    """A ``parse`` for ``--top``: a surface's name, its id (digits), or ``none``."""
+    text = text.strip()
+    if text.lower() == "none":
+        return None
+    return int(text) if text.isdigit() else text
+
+
+class MapProductsStep(StepOptions):
+    """Map products of a structural model, as GIS layers (:func:`geobrep.map_products`): the
+    outline of each block on the map plane (layer ``block_outlines``), where faults and
+    horizons meet the ``top`` surface (``traces``), and sections at ``section_levels`` (z) and
+    on ``section_planes`` (``sections``, and ``sections_plane`` in a plane's own coordinates).
+    The scene becomes the products, in the model's CRS (write it to GeoPackage)."""
+
+    kind: ClassVar[str] = "map_products"
+
+    top: Annotated[str | int | None, Cli(parse=_top, metavar="NAME")] = "top"
+    """the top (topographic) surface of the traces, by name or id (none: no traces)"""
+    section_levels: Annotated[
+        tuple[FiniteFloat, ...], Cli(parse=comma_numbers(None, "levels"), metavar="Z,Z,...")
+    ] = ()
+    """z values of horizontal sections"""
+    section_planes: Annotated[
+        tuple[Plane4, ...],
+        Cli(
+            flags=("--section-plane",),
+            append=True,
+            parse=comma_numbers(4, "plane coefficients"),
+            metavar="A,B,C,D",
+        ),
+    ] = ()
+    """other section planes a·x + b·y + c·z + d = 0 (vertical sections; repeatable)"""
+    elevation: FiniteFloat = 0.0
+    """z of the block outlines"""
+    with_section_lines: bool = False
+    """add the lines where horizons, faults and boundaries cross the section planes"""
+    section_coordinates: Literal["world", "plane", "both"] = "both"
+    """sections of vertical and inclined planes in world coordinates, in their plane's own, or
+    both"""
+
+
 class OutputStep(StepOptions):
     """A step that writes a file (``write``, ``convert``, ``render``, ``view``): the scene as
     it is at this step goes to ``<output>/<name>`` and flows on unchanged. ``name`` is a
@@ -694,6 +737,7 @@ _STEP_TYPES: tuple[type[StepOptions], ...] = (
     VoxelizeStep,
     CheckStep,
     RepairStep,
+    MapProductsStep,
     WriteStep,
     ConvertStep,
     RenderStep,
@@ -759,6 +803,10 @@ class RepairEntry(_Entry):
     repair: RepairStep
 
 
+class MapProductsEntry(_Entry):
+    map_products: MapProductsStep
+
+
 class WriteEntry(_Entry):
     write: WriteStep
 
@@ -802,6 +850,7 @@ Step = Annotated[
         Annotated[VoxelizeEntry, Tag("voxelize")],
         Annotated[CheckEntry, Tag("check")],
         Annotated[RepairEntry, Tag("repair")],
+        Annotated[MapProductsEntry, Tag("map_products")],
         Annotated[WriteEntry, Tag("write")],
         Annotated[ConvertEntry, Tag("convert")],
         Annotated[RenderEntry, Tag("render")],

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import time
 import warnings
+from collections import Counter
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from os import PathLike
@@ -48,6 +49,7 @@ from geobrep.batch.pipeline import (
     ClipStep,
     ConvertStep,
     FitStep,
+    MapProductsStep,
     OperationStep,
     OutputStep,
     Pipeline,
@@ -513,6 +515,14 @@ def _repair(step: RepairStep, scene: Scene, work: _Work) -> Applied:
     return repaired, [f"repair: {done or 'nothing to mend'}"]
 
 
+def _map_products(step: MapProductsStep, scene: Scene, work: _Work) -> Applied:
+    from geobrep.batch.operations import map_scene_products
+
+    products = map_scene_products(scene, step)
+    layers = Counter(str(e.metadata.get("layer", "?")) for e in products.entities)
+    return products, [", ".join(f"{layer} {n}" for layer, n in layers.items()) or "no products"]
+
+
 def _operation(step: OperationStep, scene: Scene, work: _Work) -> Applied:
     spec = work.registries.operations.for_step(step.operation)
     if spec is None:  # checked before the run: the plugin went away meanwhile
@@ -630,6 +640,7 @@ _APPLY: dict[type[StepOptions], Callable[[Any, Scene, _Work], Applied]] = {
     VoxelizeStep: _voxelize,
     CheckStep: _check,
     RepairStep: _repair,
+    MapProductsStep: _map_products,
     WriteStep: _write,
     ConvertStep: _write,
     RenderStep: _write,

@@ -51,6 +51,7 @@ COMMANDS: tuple[Command, ...] = (
     Command("check", "check", operation="check"),
     Command("repair", "repair", operation="repair"),
     Command("fit", "fit", operation="fit"),
+    Command("map", "map", operation="map_products"),
     Command("run", "run", text=_RUN),
     Command("clean", "clean", text="remove temporaries left by interrupted writes"),
 )
