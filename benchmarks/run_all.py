@@ -2,17 +2,13 @@
 
 from __future__ import annotations
 
-import os
+import runpy
 import sys
-
-# benchmarks/inspect.py is named after the stdlib module: keep this folder off sys.path so that
-# `import inspect` (numpy, pydantic) finds the standard one.
-sys.path[:] = [p for p in sys.path if os.path.abspath(p or ".") != os.path.dirname(__file__)]
-
-import runpy  # noqa: E402
-from pathlib import Path  # noqa: E402
+from pathlib import Path
 
 HERE = Path(__file__).parent
+# the scripts import their helpers (_inputs.py, formats_io.py) from this folder
+sys.path.insert(0, str(HERE))
 
 # The issue-17 table first; modules named _*.py are helpers, not benchmarks.
 FIRST = HERE / "user_work.py"

@@ -32,8 +32,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 DATA = ROOT / "tests" / "data" / "gocad"
 BIN = Path(sys.executable).parent
-# benchmarks/inspect.py is named after the stdlib module: the folder (first on sys.path when this
-# script is run directly) goes last, so `import inspect` finds the standard one and `_inputs` ours.
+# _inputs.py lives beside this file (no script here is named after a standard module, so the
+# folder may stand anywhere on sys.path)
 sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != HERE]
 sys.path.append(str(HERE))
 

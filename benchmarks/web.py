@@ -28,8 +28,7 @@ from typing import Any
 
 import numpy as np
 
-# formats_io.py lives beside this file; appended (benchmarks/inspect.py must not shadow the
-# standard module, so this folder is never first on sys.path).
+# formats_io.py lives beside this file
 sys.path.append(str(Path(__file__).parent))
 from formats_io import make_surface, summary, timed
 

@@ -268,3 +268,10 @@ def test_no_package_name_is_shadowed_by_its_submodule(package: Path) -> None:
         if isinstance(node, ast.FunctionDef | ast.ClassDef | ast.AsyncFunctionDef)
     }
     assert not defined & submodules, f"{sorted(defined & submodules)} shadowed in {package.name}"
+
+
+def test_no_benchmark_script_shadows_a_standard_module() -> None:
+    """A script run from benchmarks/ puts that folder first on sys.path: a file named after a
+    standard module (inspect.py did) would replace it for numpy and everything else."""
+    names = {path.stem for path in (ROOT / "benchmarks").glob("*.py")}
+    assert not names & set(sys.stdlib_module_names)

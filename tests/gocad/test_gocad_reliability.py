@@ -156,15 +156,6 @@ def _pline(axis_line: str) -> str:
     )
 
 
-def _ordinary_pline(size: int) -> str:
-    """A PLine of about ``size`` bytes of plain VRTX and SEG lines."""
-    n = size // 60
-    x = np.arange(n, dtype=np.float64) * 0.123456789
-    vertices = "".join(f"VRTX {i + 1} {v!r} {2 * v!r} {-v!r}\n" for i, v in enumerate(x))
-    segments = "".join(f"SEG {i} {i + 1}\n" for i in range(1, n))
-    return f"GOCAD PLine 1\nHEADER {{\nname:l\n}}\nILINE\n{vertices}{segments}END\n"
-
-
 def _model3d_with_long_region_line(size: int) -> str:
     """modelA1.ml with the Universe's side list repeated on one line of about ``size`` bytes
     (before its closing 0): the same model, every side listed many times."""
@@ -202,20 +193,16 @@ LONG_LINES: dict[str, tuple[str, Callable[[int], str]]] = {
 
 
 @pytest.mark.parametrize("case", sorted(LONG_LINES))
-def test_a_3mb_line_reads_in_about_the_time_of_a_3mb_ordinary_file(
-    case: str, tmp_path: Path
-) -> None:
-    ordinary = tmp_path / "ordinary.pl"
-    ordinary.write_text(_ordinary_pline(3 * MB))
+def test_a_3mb_line_reads_within_the_hang_guard(case: str, tmp_path: Path) -> None:
+    """A reader quadratic in the length of a line took over 120 s on these 3 MB lines (19 s at
+    1 MB, the reproducer); linear ones take about a second. The guard (GUARD_SECONDS) tells
+    them apart on any machine, however loaded, with no timing assertion; the time itself is
+    printed by ``benchmarks/long_lines.py`` next to an ordinary file of the same size."""
     suffix, build = LONG_LINES[case]
     long = tmp_path / f"long{suffix}"
     long.write_text(build(3 * MB))
     assert long.stat().st_size >= 2.9 * MB
-    assert ordinary.stat().st_size >= 2.9 * MB
-    timed_read(ordinary)  # imports and caches warmed
-    reference = min(timed_read(ordinary)[0] for _ in range(2))
-    seconds, result = timed_read(long)
-    assert seconds <= 10 * max(reference, 0.05), (seconds, reference)
+    _, result = timed_read(long)
     assert isinstance(result, geobrep.Scene), result
 
 

@@ -17,7 +17,7 @@ Counting conventions differ, and each difference is printed with its reason: Ope
 an orientation defect per polygon *edge* seen from each side (a flipped triangle inside a mesh:
 3 edges x 2 sides), geobrep per *face* to flip.
 
-    python benchmarks/inspect.py [--quick]
+    python benchmarks/inspection.py [--quick]
 """
 
 from __future__ import annotations
