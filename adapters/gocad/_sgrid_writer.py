@@ -17,10 +17,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.gocad._headers import quote_rest
-from geobrep.adapters.gocad._numbers import format_float
 from geobrep.adapters.gocad._objects import crs_block, gocad_metadata, report, z_sign_of
 from geobrep.adapters.gocad._sgrid import FLAGS, REGION_FLAGS
-from geobrep.adapters.gocad._voxet_writer import SAFE_NAME, dtype_words, final_name
+from geobrep.adapters.gocad._voxet_writer import (
+    SAFE_NAME,
+    dtype_words,
+    final_name,
+    property_header,
+)
 from geobrep.errors import FormatError
 from geobrep.model.crs import CRS
 from geobrep.model.entities import StructuredGrid
@@ -66,15 +70,7 @@ def _property_lines(
 ) -> tuple[list[str], NDArray[Any]]:
     values = np.asarray(prop.values)
     dtype, words = dtype_words(values, name)
-    lines = [f"PROPERTY {number} {quote_rest(name)}"]
-    section = prop.metadata.get("gocad")
-    kind = section.get("kind") if isinstance(section, dict) else None
-    if isinstance(kind, str) and kind:
-        lines.append(f"PROPERTY_KIND {number} {quote_rest(kind)}")
-    if prop.unit:
-        lines.append(f"PROP_UNIT {number} {prop.unit}")
-    if prop.no_data_value is not None:
-        lines.append(f"PROP_NO_DATA_VALUE {number} {format_float(prop.no_data_value)}")
+    lines = property_header(number, name, prop)
     lines += [f"{k} {number} {v}" for k, v in zip(words[::2], words[1::2], strict=True)]
     lines += [
         f"PROP_ALIGNMENT {number} {alignment}",

@@ -25,7 +25,7 @@ from geobrep.model.entities import RegularGrid
 from geobrep.model.properties import Property
 from geobrep.ops.io import atomic_write
 
-__all__ = ["SAFE_NAME", "dtype_words", "final_name", "voxet_text", "write_voxet"]
+__all__ = ["SAFE_NAME", "dtype_words", "final_name", "property_header", "voxet_text", "write_voxet"]
 
 SAFE_NAME = re.compile(r"[^A-Za-z0-9_.-]+")
 
@@ -48,6 +48,21 @@ def _layout(grid: RegularGrid) -> tuple[dict[str, Property], NDArray[np.float64]
         return dict(grid.point_data), grid.origin, grid.point_counts
     centre = grid.origin + 0.5 * (grid.u + grid.v + grid.w)
     return dict(grid.cell_data), centre, grid.counts
+
+
+def property_header(number: int, name: str, prop: Property) -> list[str]:
+    """The ``PROPERTY`` line of property ``number`` of a Voxet or SGrid header, with its kind,
+    unit and no-data value (the lines on its file follow)."""
+    lines = [f"PROPERTY {number} {quote_rest(name)}"]
+    section = prop.metadata.get("gocad")
+    kind = section.get("kind") if isinstance(section, dict) else None
+    if isinstance(kind, str) and kind:
+        lines.append(f"PROPERTY_KIND {number} {quote_rest(kind)}")
+    if prop.unit:
+        lines.append(f"PROP_UNIT {number} {prop.unit}")
+    if prop.no_data_value is not None:
+        lines.append(f"PROP_NO_DATA_VALUE {number} {format_float(prop.no_data_value)}")
+    return lines
 
 
 def dtype_words(values: NDArray[Any], name: str) -> tuple[np.dtype[Any], list[str]]:
@@ -96,15 +111,7 @@ def voxet_text(
     for number, (name, prop) in enumerate(props.items(), start=1):
         values = np.asarray(prop.values)
         dtype, words = dtype_words(values, name)
-        lines.append(f"PROPERTY {number} {quote_rest(name)}")
-        section = prop.metadata.get("gocad")
-        kind = section.get("kind") if isinstance(section, dict) else None
-        if isinstance(kind, str) and kind:
-            lines.append(f"PROPERTY_KIND {number} {quote_rest(kind)}")
-        if prop.unit:
-            lines.append(f"PROP_UNIT {number} {prop.unit}")
-        if prop.no_data_value is not None:
-            lines.append(f"PROP_NO_DATA_VALUE {number} {format_float(prop.no_data_value)}")
+        lines += property_header(number, name, prop)
         if ascii_file is not None:
             arrays[name] = values
             continue
