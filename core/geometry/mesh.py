@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from geobrep.errors import DegenerateGeometryError, EntityValidationError
-from geobrep.geometry.arrays import FloatArray, IntArray
+from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.geometry.bbox import column_extremes
 from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
 
@@ -24,6 +24,7 @@ __all__ = [
     "face_areas",
     "face_centroids",
     "face_normals",
+    "first_of_duplicates",
     "flip_faces",
     "is_closed",
     "is_consistently_oriented",
@@ -423,6 +424,21 @@ def _merge_candidates(local: FloatArray, tol: float) -> IntArray:
     crowded[order[1:][same]] = True
     crowded[order[:-1][same]] = True
     return np.flatnonzero(near_face | crowded).astype(np.int64)
+
+
+def first_of_duplicates(cells: ArrayLike) -> BoolArray:
+    """True for each cell (row of vertex ids) not seen before in any corner order: the cells to
+    keep when dropping duplicated elements.
+
+    >>> first_of_duplicates([[0, 1, 2], [2, 1, 0], [1, 2, 3]]).tolist()
+    [True, False, True]
+    """
+    rows = np.asarray(cells)
+    keep = np.zeros(rows.shape[0], dtype=np.bool_)
+    if rows.shape[0]:
+        _, first = np.unique(np.sort(rows, axis=1), axis=0, return_index=True)
+        keep[first] = True
+    return keep
 
 
 def compact_indices(indices: ArrayLike, n: int) -> tuple[IntArray, IntArray]:

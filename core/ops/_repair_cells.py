@@ -210,9 +210,7 @@ def _tet_degenerate(tets: TetMesh, tol: float) -> tuple[TetMesh, int]:
 def _tet_duplicates(tets: TetMesh, tol: float) -> tuple[TetMesh, int]:
     if tets.n_cells < 2:
         return tets, 0
-    _, first = np.unique(np.sort(tets.cells, axis=1), axis=0, return_index=True)
-    keep = np.zeros(tets.n_cells, dtype=np.bool_)
-    keep[first] = True
+    keep = mesh.first_of_duplicates(tets.cells)
     count = int((~keep).sum())
     return (_take_tets(tets, keep), count) if count else (tets, 0)
 

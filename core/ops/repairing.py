@@ -164,9 +164,7 @@ def _drop_degenerate(surface: Surface, tol: float) -> tuple[Surface, int]:
 def _drop_duplicates(surface: Surface, tol: float) -> tuple[Surface, int]:
     if surface.n_faces < 2:
         return surface, 0
-    _, first = np.unique(np.sort(surface.faces, axis=1), axis=0, return_index=True)
-    keep = np.zeros(surface.n_faces, dtype=np.bool_)
-    keep[first] = True
+    keep = mesh.first_of_duplicates(surface.faces)
     count = int((~keep).sum())
     return (_take(surface, keep), count) if count else (surface, 0)
 
