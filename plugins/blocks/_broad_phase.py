@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.plugins.blocks._csr import concatenated_ranges
 
-__all__ = ["overlapping_pairs"]
+__all__ = ["overlapping_pairs", "stored_pairs"]
 
 
 #: Triangles larger than this many median extents are kept only in the cells they come near.
@@ -163,11 +163,19 @@ def overlapping_pairs(
     >>> i.tolist(), j.tolist()
     ([0], [1])
     """
-    n = corners.shape[0]
+    stored = np.ascontiguousarray(np.transpose(corners, (1, 2, 0)), dtype=np.float64)
+    return stored_pairs(stored, groups, margin, cell)
+
+
+def stored_pairs(
+    stored: FloatArray, groups: IntArray, margin: float = 0.0, cell: float | None = None
+) -> tuple[IntArray, IntArray]:
+    """:func:`overlapping_pairs` of triangles given component-major, ``stored`` (corner, xyz,
+    K) float64, as callers that gather the corners that way pass them (no transposed copy)."""
+    n = stored.shape[2]
     empty = np.zeros(0, dtype=np.int64)
     if n == 0:
         return empty, empty
-    stored = np.ascontiguousarray(np.transpose(corners, (1, 2, 0)), dtype=np.float64)
     mins, maxs = _boxes(stored, margin)
     size = maxs - mins
     extent = np.maximum(np.maximum(size[0], size[1]), size[2])  # margins included

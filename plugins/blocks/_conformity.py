@@ -26,7 +26,7 @@ import numpy as np
 
 from geobrep.errors import TopologyError
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
-from geobrep.plugins.blocks._broad_phase import overlapping_pairs
+from geobrep.plugins.blocks._broad_phase import overlapping_pairs, stored_pairs
 from geobrep.plugins.blocks._csr import concatenated_ranges
 from geobrep.plugins.blocks._patches import PatchSplit
 from geobrep.plugins.blocks._soup import Soup
@@ -36,6 +36,7 @@ __all__ = [
     "NonConformity",
     "check_conformity",
     "find_defects",
+    "free_border",
     "point_triangle_distance",
     "separated",
     "triangles_intersect",
@@ -393,15 +394,16 @@ def _away_from(
 
 
 def _along_shared_lines(
-    soup: Soup, corners: FloatArray, i: IntArray, j: IntArray, tol: float
+    soup: Soup, one: FloatArray, other: FloatArray, i: IntArray, j: IntArray, tol: float
 ) -> BoolArray:
-    """Pairs that meet only within ``ARC_MARGIN × tol`` of edges the two surfaces share: a
-    vertex of one surface beside the line where it meets the other (a sliver triangle sealing
-    a vertex the other surface does not have, moved off that line by rounding) is no defect."""
+    """Pairs (triangles ``i`` and ``j``, corners ``one`` and ``other``) that meet only within
+    ``ARC_MARGIN × tol`` of edges the two surfaces share: a vertex of one surface beside the
+    line where it meets the other (a sliver triangle sealing a vertex the other surface does
+    not have, moved off that line by rounding) is no defect."""
     surface = soup.triangle_surface
     margin = ARC_MARGIN * tol
-    first, gone_first = _away_from(corners[i], _shared_edges(soup, i, surface[j]), margin)
-    second, gone_second = _away_from(corners[j], _shared_edges(soup, j, surface[i]), margin)
+    first, gone_first = _away_from(one, _shared_edges(soup, i, surface[j]), margin)
+    second, gone_second = _away_from(other, _shared_edges(soup, j, surface[i]), margin)
     benign = gone_first | gone_second
     rest = np.flatnonzero(~benign)
     benign[rest] = ~triangles_intersect(first[rest], second[rest], tol)
@@ -412,13 +414,14 @@ def _crossings(
     soup: Soup, tol: float, pairs: tuple[IntArray, IntArray] | None = None
 ) -> list[NonConformity]:
     """Crossings and T-junctions between triangles of different surfaces; ``pairs``: the
-    candidate pairs when the caller's broad phase (a wider margin) already found them."""
+    candidate pairs when the caller's broad phase (a wider margin) already found them (only
+    their triangles are gathered then)."""
     local = soup.local(soup.vertices)
-    corners = local[soup.triangles]
     if pairs is None:
+        corners = local[soup.triangles]
         i, j = overlapping_pairs(corners, soup.triangle_surface, margin=tol)
     else:
-        i, j = _boxes_within(corners, *pairs, tol)
+        i, j = _boxes_within(local, soup.triangles, *pairs, tol)
     if i.size == 0:
         return []
     ti, tj = soup.triangles[i].T, soup.triangles[j].T
@@ -427,19 +430,19 @@ def _crossings(
         for b in range(3):
             apart &= ti[a] != tj[b]
     i, j = i[apart], j[apart]
-    hit = triangles_intersect(corners[i], corners[j], tol)
-    i, j = i[hit], j[hit]
+    first, second = local[soup.triangles[i]], local[soup.triangles[j]]
+    hit = triangles_intersect(first, second, tol)
+    i, j, first, second = i[hit], j[hit], first[hit], second[hit]
     if i.size == 0:
         return []
-    real = ~_along_shared_lines(soup, corners, i, j, tol)
-    i, j = i[real], j[real]
+    real = ~_along_shared_lines(soup, first, second, i, j, tol)
+    i, j, first, second = i[real], j[real], first[real], second[real]
     if i.size == 0:
         return []
     touch = np.minimum(
-        _vertex_triangle_distance(corners[i], corners[j]),
-        _vertex_triangle_distance(corners[j], corners[i]),
+        _vertex_triangle_distance(first, second), _vertex_triangle_distance(second, first)
     )
-    middle = 0.5 * (corners[i].mean(axis=1) + corners[j].mean(axis=1)) + soup.centre
+    middle = 0.5 * (first.mean(axis=1) + second.mean(axis=1)) + soup.centre
     surface = soup.triangle_surface
     return [
         NonConformity(
@@ -471,17 +474,35 @@ def _allowed_surfaces(soup: Soup, border: IntArray) -> IntArray:
 
 
 def _boxes_within(
-    corners: FloatArray, i: IntArray, j: IntArray, margin: float
+    local: FloatArray, triangles: IntArray, i: IntArray, j: IntArray, margin: float
 ) -> tuple[IntArray, IntArray]:
-    """The pairs whose triangles' boxes, grown by ``margin``, overlap."""
+    """The pairs whose triangles' boxes (corners ``local[triangles]``), grown by ``margin``,
+    overlap; only the paired triangles are gathered."""
     keep = np.ones(i.shape[0], dtype=np.bool_)
+    if i.size == 0:
+        return i, j
+    mine, theirs = triangles[i], triangles[j]
     for axis in range(3):
-        low, high = corners[:, :, axis].min(axis=1), corners[:, :, axis].max(axis=1)
-        keep &= (low[i] - margin <= high[j] + margin) & (low[j] - margin <= high[i] + margin)
+        column = np.ascontiguousarray(local[:, axis])
+        one, other = column[mine], column[theirs]
+        keep &= one.min(axis=1) - margin <= other.max(axis=1) + margin
+        keep &= other.min(axis=1) - margin <= one.max(axis=1) + margin
     return i[keep], j[keep]
 
 
-def _border(soup: Soup, split: PatchSplit) -> tuple[IntArray, IntArray, IntArray]:
+#: The free border: edges (B, 2) one triangle uses, their vertices, each vertex's surface.
+Border = tuple[IntArray, IntArray, IntArray]
+
+
+def _sorted_unique(values: IntArray) -> IntArray:
+    """The distinct values, ascending, by one sort (numpy's hashing ``unique`` is slower)."""
+    ordered = np.sort(values.reshape(-1))
+    keep = np.ones(ordered.shape[0], dtype=np.bool_)
+    keep[1:] = ordered[1:] != ordered[:-1]
+    return ordered[keep]
+
+
+def _border(soup: Soup, split: PatchSplit) -> Border:
     """The free border edges (B, 2), their vertices and each soup vertex's border surface."""
     free = np.flatnonzero(np.diff(split.offsets) == 1)
     border = split.edges[free]
@@ -489,29 +510,65 @@ def _border(soup: Soup, split: PatchSplit) -> tuple[IntArray, IntArray, IntArray
     border_surface = soup.triangle_surface[split.incident_triangles[split.offsets[free]]]
     owner[border[:, 0]] = border_surface
     owner[border[:, 1]] = border_surface
-    return border, np.unique(border), owner
+    return border, _sorted_unique(border), owner
+
+
+def free_border(soup: Soup) -> Border:
+    """What :func:`_border` gives from the patch split, without splitting: one sort of the
+    triangle sides packed as ``(edge key · S + surface)``; an edge whose key appears once is
+    free (same edges, same order: ascending ``(low, high)``).
+
+    >>> import geobrep
+    >>> from geobrep.plugins.blocks._patches import split_patches
+    >>> from geobrep.plugins.blocks._soup import build_soup
+    >>> surfaces = geobrep.datasets.faulted_layer_cake().surfaces
+    >>> soup = build_soup([s for s in surfaces if s.name != "top"], None, 1e-7)
+    >>> mine, theirs = free_border(soup), _border(soup, split_patches(soup))
+    >>> all(np.array_equal(a, b) for a, b in zip(mine, theirs)), mine[0].shape[0] > 0
+    (True, True)
+    """
+    n_vertices, n_surfaces = soup.vertices.shape[0], max(len(soup.surfaces), 1)
+    if n_vertices * n_vertices * n_surfaces >= 2**62:
+        from geobrep.plugins.blocks._patches import split_patches
+
+        return _border(soup, split_patches(soup))
+    tri = soup.triangles
+    low = np.minimum(tri, tri[:, _NEXT])
+    high = np.maximum(tri, tri[:, _NEXT])
+    side = (low * n_vertices + high) * n_surfaces + soup.triangle_surface[:, None]
+    packed = np.sort(side.reshape(-1))
+    edge = packed // n_surfaces
+    alone = np.ones(edge.shape[0], dtype=np.bool_)
+    alone[1:] = edge[1:] != edge[:-1]
+    alone[:-1] &= edge[:-1] != edge[1:]
+    key, surface = edge[alone], packed[alone] % n_surfaces
+    border = np.stack([key // n_vertices, key % n_vertices], axis=1)
+    owner = np.full(n_vertices, -1, dtype=np.int64)
+    owner[border[:, 0]] = surface
+    owner[border[:, 1]] = surface
+    return border, _sorted_unique(border), owner
 
 
 def _gaps(
     soup: Soup,
-    split: PatchSplit,
+    free: Border,
     gap_tolerance: float,
     tol: float,
     pairs: tuple[IntArray, IntArray] | None = None,
 ) -> list[NonConformity]:
-    """Gaps (and T-junctions) between free border vertices and other surfaces; ``pairs``:
-    candidate (border point, triangle) pairs when the caller's broad phase found them."""
-    border, points, owner = _border(soup, split)
+    """Gaps (and T-junctions) between free border vertices (``free``: the soup's free border)
+    and other surfaces; ``pairs``: candidate (border point, triangle) pairs when the caller's
+    broad phase found them."""
+    border, points, owner = free
     if border.shape[0] == 0 or gap_tolerance <= 0.0:
         return []
     local = soup.local(soup.vertices)
-    corners = local[soup.triangles]
     n_points = points.shape[0]
     if pairs is None:
         dots = np.repeat(local[points][:, None, :], 3, axis=1)
         groups = np.concatenate([np.zeros(n_points, np.int64), np.ones(soup.n_triangles, np.int64)])
         p, t = overlapping_pairs(
-            np.concatenate([dots, corners]), groups, margin=0.5 * gap_tolerance
+            np.concatenate([dots, local[soup.triangles]]), groups, margin=0.5 * gap_tolerance
         )
         t = t - n_points
     else:
@@ -524,7 +581,8 @@ def _gaps(
     vertex, t = vertex[~allowed], t[~allowed]
     if vertex.size == 0:
         return []
-    distance = point_triangle_distance(local[vertex], corners[t, 0], corners[t, 1], corners[t, 2])
+    corners = local[soup.triangles[t]]
+    distance = point_triangle_distance(local[vertex], corners[:, 0], corners[:, 1], corners[:, 2])
     close = distance <= gap_tolerance
     vertex, t, distance = vertex[close], t[close], distance[close]
     # One defect per border vertex: its nearest other surface.
@@ -567,25 +625,29 @@ def _hint(soup: Soup, defects: list[NonConformity], gap_tolerance: float) -> str
     return text + "; check_conformity=False / --no-conformity-check skips it)"
 
 
-def find_defects(soup: Soup, split: PatchSplit, gap_tolerance: float) -> list[NonConformity]:
-    """Every crossing, T-junction and gap of the soup (what :func:`check_conformity` raises).
+def find_defects(soup: Soup, split: PatchSplit | None, gap_tolerance: float) -> list[NonConformity]:
+    """Every crossing, T-junction and gap of the soup (what :func:`check_conformity` raises);
+    the free border comes from ``split``, else (``None``) from :func:`free_border`.
 
     One broad phase serves both searches: the triangles and the free border points (a group
     of their own, after every surface) at the wider of the two margins; triangle pairs are
     then kept where their boxes come within the contact tolerance, point-triangle pairs go to
     the gap search."""
     tol = soup.tolerance
-    border, points, _ = _border(soup, split)
+    free = free_border(soup) if split is None else _border(soup, split)
+    border, points, _ = free
     if border.shape[0] == 0 or gap_tolerance <= 0.0:
-        return _crossings(soup, tol) + _gaps(soup, split, gap_tolerance, tol)
-    local = soup.local(soup.vertices)
+        return _crossings(soup, tol) + _gaps(soup, free, gap_tolerance, tol)
     n = soup.n_triangles
-    dots = np.repeat(local[points][:, None, :], 3, axis=1)
-    corners = np.concatenate([local[soup.triangles], dots])
+    columns = np.ascontiguousarray(soup.local(soup.vertices).T)
+    stored = np.empty((3, 3, n + points.shape[0]))  # component-major: (corner, xyz, K)
+    for corner in range(3):
+        stored[corner, :, :n] = columns[:, soup.triangles[:, corner]]
+        stored[corner, :, n:] = columns[:, points]
     groups = np.concatenate(
         [soup.triangle_surface, np.full(points.shape[0], len(soup.surfaces), np.int64)]
     )
-    i, j = overlapping_pairs(corners, groups, margin=max(tol, 0.5 * gap_tolerance))
+    i, j = stored_pairs(stored, groups, margin=max(tol, 0.5 * gap_tolerance))
     # groups[i] < groups[j]: a border point (the last group) is always j.
     to_point = j >= n
     first, second = i[~to_point], j[~to_point]
@@ -594,7 +656,7 @@ def find_defects(soup: Soup, split: PatchSplit, gap_tolerance: float) -> list[No
     p, t = j[to_point] - n, i[to_point]
     order = np.lexsort((t, p))
     crossings = _crossings(soup, tol, triangle_pairs)
-    return crossings + _gaps(soup, split, gap_tolerance, tol, (p[order], t[order]))
+    return crossings + _gaps(soup, free, gap_tolerance, tol, (p[order], t[order]))
 
 
 def check_conformity(soup: Soup, split: PatchSplit, gap_tolerance: float) -> None:

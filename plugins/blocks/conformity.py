@@ -29,7 +29,6 @@ from geobrep.plugins.blocks._conformity import (
     point_triangle_distance,
     triangles_intersect,
 )
-from geobrep.plugins.blocks._patches import split_patches
 from geobrep.plugins.blocks._radial_sort import half_plane_angles
 from geobrep.plugins.blocks._soup import Soup, build_soup
 
@@ -109,9 +108,8 @@ def surface_nonconformities(
     gap = gap_tolerance if gap_tolerance is not None else relative_gap_tolerance * soup.diagonal
     if soup.n_triangles == 0:
         return Nonconformities([], soup.tolerance, soup.tolerance_source)
-    split = split_patches(soup)
     found = []
-    for item in find_defects(soup, split, gap):
+    for item in find_defects(soup, None, gap):  # the free border without the patch split
         first, second = item.triangles
         if item.vertex >= 0:  # a border vertex near another surface
             owner = _owner_of(soup, item.vertex, item.surfaces[0])
