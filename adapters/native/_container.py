@@ -42,7 +42,9 @@ _NPY_HEADER: Final = 10_000
 class NativeDocument(BaseModel):
     """The content of ``scene.json``."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid", title="geobrep scene document")
+    model_config = ConfigDict(
+        frozen=True, extra="forbid", title="geobrep scene document", defer_build=True
+    )
 
     format: Literal["geobrep-scene"] = FORMAT_ID
     version: Literal[1] = FORMAT_VERSION

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from importlib.metadata import EntryPoint
+from importlib.metadata import Distribution, EntryPoint
 
 __all__ = ["ENTRY_POINT_GROUP", "PROJECT_NAME", "distribution", "is_builtin", "is_own"]
 
@@ -20,7 +20,16 @@ def distribution(entry_point: EntryPoint) -> tuple[str | None, str | None]:
     dist = getattr(entry_point, "dist", None)
     if dist is None:
         return None, None
-    return dist.name, dist.version
+    found = _NAMES.get(id(dist))
+    if found is None or found[0] is not dist:
+        # ``dist.name`` and ``dist.version`` each parse the METADATA file again: once per
+        # distribution object (which all its entry points share) is enough
+        found = _NAMES[id(dist)] = (dist, dist.name, dist.version)
+    return found[1], found[2]
+
+
+#: ``id(dist)`` -> the distribution (kept, so its id is not reused), its name and version.
+_NAMES: dict[int, tuple[Distribution, str, str]] = {}
 
 
 def is_own(entry_point: EntryPoint) -> bool:

@@ -45,7 +45,7 @@ def structurally_equal(a: Any, b: Any) -> bool:
 class FrozenModel(BaseModel):
     """Immutable model with structural equality (unhashable: it may hold arrays)."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", defer_build=True)
 
     def __eq__(self, other: object) -> bool:
         if type(other) is not type(self):

@@ -41,7 +41,7 @@ class BoundaryCurve(BaseModel):
     gap: ``BoundaryCurve.from_surface(left, "u1")`` is the right-hand edge of ``left``.
     """
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", defer_build=True)
 
     degree: int = Field(ge=1, le=9)
     knots: list[float]
@@ -90,7 +90,9 @@ class BoundaryCurve(BaseModel):
 
 
 class _FitOptions(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid", arbitrary_types_allowed=True)
+    model_config = ConfigDict(
+        frozen=True, extra="forbid", arbitrary_types_allowed=True, defer_build=True
+    )
 
     epsilon: float | None = Field(default=None, gt=0)
     """Control error ε: the report passes when σ < ε (and the net size is chosen to meet it)."""

@@ -32,7 +32,21 @@ import contextlib, io, json, sys
 from geobrep.cli import main
 with contextlib.redirect_stdout(io.StringIO()) as out:
     code = main(sys.argv[1:])
-print(json.dumps({"code": code, "out": out.getvalue(), "modules": sorted(sys.modules)}))
+
+def models():  # the pydantic models whose validators were built (schemas are deferred)
+    if "pydantic" not in sys.modules:
+        return []
+    from pydantic import BaseModel
+    seen, todo = set(), [BaseModel]
+    while todo:
+        for sub in todo.pop().__subclasses__():
+            if sub not in seen:
+                seen.add(sub)
+                todo.append(sub)
+    return sorted(f"{c.__module__}.{c.__qualname__}" for c in seen if c.__pydantic_complete__)
+
+found = {"code": code, "out": out.getvalue(), "modules": sorted(sys.modules), "built": models()}
+print(json.dumps(found))
 """
 
 #: What listing the commands must not load: the models, numpy, the plugins and their host.
@@ -62,6 +76,14 @@ NOT_FOR_INFO = (
     "geobrep.batch.operations",
     "geobrep.cli.operation",
     *(f"geobrep.cli.{c.module}" for c in COMMANDS if c.module != "info"),
+)
+
+
+#: Models whose validators describing a TSurf must not build (their schemas are deferred).
+NOT_BUILT_FOR_INFO = (
+    "geobrep.adapters.native._container.NativeDocument",
+    "geobrep.plugins.fit.options.",
+    "geobrep.batch.",
 )
 
 
@@ -97,6 +119,14 @@ def test_info_of_a_tsurf_loads_only_what_it_needs() -> None:
     modules = found["modules"]
     assert not loaded(modules, NOT_FOR_INFO)
     assert "geobrep.adapters.gocad._reader" in modules  # it did read through GOCAD
+    # The models' validators are built on first use: of the entity models only the Surface the
+    # file holds (the scene's union of entity types does not build each type's own), and none
+    # of the models of formats and operations the command does not use.
+    built = found["built"]
+    assert isinstance(built, list)
+    entities = {name.rsplit(".", 1)[1] for name in built if ".model.entities." in name}
+    assert entities == {"Surface"}
+    assert not [name for name in built if name.startswith(NOT_BUILT_FOR_INFO)]
 
 
 def test_lazy_help_is_the_help_of_the_whole_parser(capsys: pytest.CaptureFixture[str]) -> None:
