@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["minimum_curvature", "tangents"]
+__all__ = ["angles", "arc_points", "minimum_curvature", "tangents"]
 
 
 def tangents(inclination: ArrayLike, azimuth: ArrayLike) -> NDArray[np.float64]:
@@ -46,3 +46,52 @@ def minimum_curvature(
     ratio = np.where(small, 1.0, np.tan(np.where(small, 1.0, half)) / np.where(small, 1.0, half))
     steps = (np.diff(depths) / 2.0 * ratio)[:, None] * (t1 + t2)
     return np.vstack([np.zeros((1, 3)), np.cumsum(steps, axis=0)])
+
+
+def angles(directions: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Inclination and azimuth in degrees (azimuth in ``[0, 360)``) of unit directions ``(n, 3)``.
+
+    >>> inc, azi = angles(tangents([30.0], [300.0]))
+    >>> np.round(inc, 9).tolist(), np.round(azi, 9).tolist()
+    ([30.0], [300.0])
+    """
+    t = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    inclination = np.degrees(np.arccos(np.clip(-t[:, 2], -1.0, 1.0)))
+    azimuth = np.mod(np.degrees(np.arctan2(t[:, 0], t[:, 1])), 360.0)
+    return inclination, np.where(azimuth >= 360.0, 0.0, azimuth)
+
+
+def arc_points(
+    start: ArrayLike, t1: ArrayLike, t2: ArrayLike, length: ArrayLike, fraction: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Points and unit tangents ``(n, 3)`` a ``fraction`` of the way along minimum-curvature arcs.
+
+    Arc ``i`` leaves ``start[i]`` in direction ``t1[i]`` and arrives in direction ``t2[i]`` after
+    ``length[i]`` (a measured-depth interval): a circular arc of dogleg ``β`` and radius
+    ``length / β``, or a straight line when ``β`` is 0. ``fraction`` 1 gives the station
+    :func:`minimum_curvature` puts at the end of the interval.
+
+    >>> point, tangent = arc_points([[0, 0, 0]], tangents([0], [90]), tangents([90], [90]),
+    ...                             [100.0], [1.0])
+    >>> np.round(point, 6).tolist(), (np.round(tangent, 12) + 0.0).tolist()
+    ([[63.661977, 0.0, -63.661977]], [[1.0, 0.0, 0.0]])
+    """
+    p0 = np.asarray(start, dtype=np.float64).reshape(-1, 3)
+    a = np.asarray(t1, dtype=np.float64).reshape(-1, 3)
+    b = np.asarray(t2, dtype=np.float64).reshape(-1, 3)
+    s = np.asarray(length, dtype=np.float64).reshape(-1) * np.asarray(fraction, np.float64)
+    span = np.asarray(length, dtype=np.float64).reshape(-1)
+    beta = np.arccos(np.clip(np.einsum("ij,ij->i", a, b), -1.0, 1.0))
+    straight = beta < 1e-9
+    sin_beta = np.where(straight, 1.0, np.sin(beta))
+    # the unit normal in the arc's plane, pointing from t1 towards t2
+    normal = (b - np.cos(beta)[:, None] * a) / sin_beta[:, None]
+    radius = np.where(straight, 0.0, span / np.where(straight, 1.0, beta))
+    phi = np.where(straight, 0.0, s / np.where(radius == 0.0, 1.0, radius))
+    bent = p0 + radius[:, None] * (np.sin(phi)[:, None] * a + (1.0 - np.cos(phi))[:, None] * normal)
+    line = p0 + s[:, None] * a
+    points = np.where(straight[:, None], line, bent)
+    direction = np.where(
+        straight[:, None], a, np.cos(phi)[:, None] * a + np.sin(phi)[:, None] * normal
+    )
+    return points, direction

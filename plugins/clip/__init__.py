@@ -40,9 +40,11 @@ def geobrep_register_clippers(registry: ClipperRegistry) -> None:
     from geobrep.plugins.clip.options import (
         AnnotationClipOptions,
         ClipOptions,
+        GridClipOptions,
         NurbsClipOptions,
         OctreeClipOptions,
         SurfaceClipOptions,
+        WellClipOptions,
     )
 
     # name, entity type, module, clipper, section (or None), options model, description
@@ -62,6 +64,17 @@ def geobrep_register_clippers(registry: ClipperRegistry) -> None:
          "Linear octrees: leaves kept, dropped, or split down to the finest level"),
         ("nurbs", "NurbsSurface", "_nurbs", "clip_nurbs", None, NurbsClipOptions,
          "NURBS surfaces: exact trimming by half-spaces, found on the tessellation"),
+        ("regular_grid", "RegularGrid", "_grids", "clip_regular_grid", "section_regular_grid",
+         GridClipOptions,
+         "Regular grids: whole cells kept by centre, inside or touching; sections as surfaces "
+         "carrying the cell data"),
+        ("structured_grid", "StructuredGrid", "_grids", "clip_structured_grid",
+         "section_structured_grid", GridClipOptions,
+         "Curvilinear and corner-point grids: whole cells kept, the rest made inactive; "
+         "sections as surfaces carrying the cell data"),
+        ("well", "Well", "_wells", "clip_well", "section_well", WellClipOptions,
+         "Wells: the path cut on its minimum-curvature arcs at the MD of the cut; markers, "
+         "zones and logs kept; sections: the crossing points or the well on the section"),
         ("block", "Block", "_blocks", "clip_block", "section_block", ClipOptions,
          "Blocks of a scene: each cut block is closed by a cap patch"),
     ]  # fmt: skip

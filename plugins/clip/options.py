@@ -11,9 +11,11 @@ from geobrep.plugins import ClipContext
 __all__ = [
     "AnnotationClipOptions",
     "ClipOptions",
+    "GridClipOptions",
     "NurbsClipOptions",
     "OctreeClipOptions",
     "SurfaceClipOptions",
+    "WellClipOptions",
     "tolerance_of",
 ]
 
@@ -69,6 +71,30 @@ class NurbsClipOptions(ClipOptions):
 
     samples: int = Field(
         default=65, ge=2, le=4097, description="Tessellation samples per parameter direction."
+    )
+
+
+class GridClipOptions(ClipOptions):
+    """Options of the RegularGrid and StructuredGrid clippers (cells are kept whole)."""
+
+    cells: Literal["centre", "inside", "touching"] = Field(
+        default="centre",
+        description="Which cells a side keeps: 'centre', those whose centre is on it (a centre "
+        "on the plane counts as positive, so keep='both' partitions the cells); 'inside', those "
+        "with no corner beyond the plane; 'touching', those with a corner strictly on it.",
+    )
+
+
+class WellClipOptions(ClipOptions):
+    """Options of the Well clipper and section."""
+
+    within: float | None = Field(
+        default=None,
+        gt=0,
+        allow_inf_nan=False,
+        description="Section only: the well on the section, the parts of its path within this "
+        "distance of the plane projected onto it (a PolyLine with md and offset), instead of "
+        "the points where it crosses the plane.",
     )
 
 

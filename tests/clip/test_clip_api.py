@@ -24,6 +24,9 @@ EXPECTED = {
     "Annotation",
     "NurbsSurface",
     "LinearOctree",
+    "RegularGrid",
+    "StructuredGrid",
+    "Well",
 }
 
 
