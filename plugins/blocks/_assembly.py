@@ -39,9 +39,11 @@ class Assembly:
 
 def _rebuilt_surface(soup: Soup, split: PatchSplit, index: int) -> tuple[Surface, IntArray] | None:
     surface = soup.surfaces[index]
-    rows = np.flatnonzero(soup.triangle_surface == index)
-    if rows.size == 0:
+    # A surface's triangles are contiguous in the soup, surfaces in order.
+    start, stop = np.searchsorted(soup.triangle_surface, [index, index + 1]).tolist()
+    if start == stop:
         return None
+    rows = slice(start, stop)
     merged = soup.triangles[rows]
     vertex_map = soup.vertex_maps[index]
     # The first original vertex of each merged vertex stands for it; keep their order.
@@ -61,7 +63,7 @@ def _rebuilt_surface(soup: Soup, split: PatchSplit, index: int) -> tuple[Surface
         name=surface.name,
         kind=surface.kind,
         metadata=surface.metadata,
-        vertices=soup.vertices[ids],
+        vertices=np.take(soup.vertices, ids, axis=0),
         faces=rank[merged],
         patch_labels=labels,
         patch_names=tuple(f"{name}:{k}" for k in range(n_labels)),

@@ -26,7 +26,7 @@ import numpy as np
 
 from geobrep.errors import TopologyError
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
-from geobrep.plugins.blocks._broad_phase import overlapping_pairs, stored_pairs
+from geobrep.plugins.blocks._broad_phase import component_major, overlapping_pairs, stored_pairs
 from geobrep.plugins.blocks._csr import concatenated_ranges
 from geobrep.plugins.blocks._patches import PatchSplit
 from geobrep.plugins.blocks._soup import Soup
@@ -418,19 +418,20 @@ def _crossings(
     their triangles are gathered then)."""
     local = soup.local(soup.vertices)
     if pairs is None:
-        corners = local[soup.triangles]
-        i, j = overlapping_pairs(corners, soup.triangle_surface, margin=tol)
+        stored = component_major(np.ascontiguousarray(local.T), soup.triangles)
+        i, j = stored_pairs(stored, soup.triangle_surface, margin=tol)
     else:
         i, j = _boxes_within(local, soup.triangles, *pairs, tol)
     if i.size == 0:
         return []
-    ti, tj = soup.triangles[i].T, soup.triangles[j].T
+    # np.take: row gathers several times faster than fancy indexing on numpy 2.
+    ti, tj = np.take(soup.triangles, i, axis=0), np.take(soup.triangles, j, axis=0)
     apart = np.ones(i.shape[0], dtype=np.bool_)
     for a in range(3):
         for b in range(3):
-            apart &= ti[a] != tj[b]
-    i, j = i[apart], j[apart]
-    first, second = local[soup.triangles[i]], local[soup.triangles[j]]
+            apart &= ti[:, a] != tj[:, b]
+    i, j, ti, tj = i[apart], j[apart], ti[apart], tj[apart]
+    first, second = np.take(local, ti, axis=0), np.take(local, tj, axis=0)
     hit = triangles_intersect(first, second, tol)
     i, j, first, second = i[hit], j[hit], first[hit], second[hit]
     if i.size == 0:
@@ -481,7 +482,7 @@ def _boxes_within(
     keep = np.ones(i.shape[0], dtype=np.bool_)
     if i.size == 0:
         return i, j
-    mine, theirs = triangles[i], triangles[j]
+    mine, theirs = np.take(triangles, i, axis=0), np.take(triangles, j, axis=0)
     for axis in range(3):
         column = np.ascontiguousarray(local[:, axis])
         one, other = column[mine], column[theirs]

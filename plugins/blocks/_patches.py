@@ -69,7 +69,8 @@ def split_patches(soup: Soup) -> PatchSplit:
     t1, t2 = incident[first], incident[second]
     same_surface = soup.triangle_surface[t1] == soup.triangle_surface[t2]
     # Consistent neighbours traverse the shared edge in opposite directions.
-    consistent = triangles[t1, sides[first]] != triangles[t2, sides[second]]
+    corner = triangles.reshape(-1)
+    consistent = np.take(corner, 3 * t1 + sides[first]) != np.take(corner, 3 * t2 + sides[second])
     manifold = same_surface & consistent
     is_arc = counts != 2
     is_arc[pair[~manifold]] = True

@@ -55,7 +55,7 @@ class Soup:
         """The same soup with only the triangles where ``keep`` is true."""
         return replace(
             self,
-            triangles=self.triangles[keep],
+            triangles=np.compress(keep, self.triangles, axis=0),  # rows: faster than [keep]
             triangle_surface=self.triangle_surface[keep],
             triangle_face=self.triangle_face[keep],
         )
@@ -129,7 +129,7 @@ def build_soup(
     return Soup(
         surfaces=surfaces,
         vertices=merged,
-        triangles=triangles[keep],
+        triangles=np.compress(keep, triangles, axis=0),
         triangle_surface=np.concatenate(surface_parts)[keep],
         triangle_face=np.concatenate(face_parts)[keep],
         vertex_maps=maps,

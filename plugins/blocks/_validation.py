@@ -71,7 +71,7 @@ def _surface_mismatches(
         )
         same = (
             built.faces.shape == (stop - start, 3)
-            and np.array_equal(built.vertices, soup.vertices[ids])
+            and np.array_equal(built.vertices, np.take(soup.vertices, ids, axis=0))
             and np.array_equal(ids[built.faces], soup.triangles[start:stop])
             and np.array_equal(lookup[labels], split.triangle_patch[start:stop])
         )
@@ -128,11 +128,14 @@ def _edge_checks(
     offsets, triangle, side = split.offsets, split.incident_triangles, split.incident_sides
     corner = soup.triangles.reshape(-1)
     counted = positive != negative  # patches inside a block are left out
-    # Edges of two triangles of one patch: both are faces of the same two blocks, and they
-    # traverse it oppositely unless both start it at the same vertex.
-    size = np.diff(offsets)
+    # Only arc edges need looking at: every other edge has two triangles of one patch that
+    # traverse it oppositely (the split's rule), so each block on its sides uses it once each way.
+    arc = split.arc_edges
+    size = offsets[arc + 1] - offsets[arc]
+    # Arc edges of two triangles of one patch (a seam the patch closes around): both are faces
+    # of the same two blocks, and they traverse it oppositely unless both start it at one vertex.
     pair = np.flatnonzero(size == 2)
-    first = offsets[pair]
+    first = offsets[arc[pair]]
     one, two = triangle[first], triangle[first + 1]
     patch = split.triangle_patch[one]
     inner = patch == split.triangle_patch[two]
@@ -140,11 +143,12 @@ def _edge_checks(
     twisted = patch[inner & same_way & counted[patch]]
     oriented[positive[twisted]] = False
     oriented[negative[twisted]] = False
-    # Every other edge: its faces grouped by block.
+    # Every other arc edge: its faces grouped by block.
     size[pair[inner]] = 0
-    others = np.flatnonzero(size)
-    edge = np.repeat(others, size[others])
-    rows = concatenated_ranges(offsets[others], size[others])
+    live = np.flatnonzero(size)
+    others, size = arc[live], size[live]
+    edge = np.repeat(others, size)
+    rows = concatenated_ranges(offsets[others], size)
     patch = split.triangle_patch[triangle[rows]]
     keep = counted[patch]
     edge, rows, patch = edge[keep], rows[keep], patch[keep]
@@ -154,7 +158,11 @@ def _edge_checks(
     along = np.concatenate([~forward, forward]).astype(np.int64)
     key = np.sort(np.concatenate([edge, edge]) * (2 * n_blocks) + 2 * block + along)
     if key.size:
-        group, first_of = np.unique(key // 2, return_index=True)
+        half = key // 2  # sorted: groups are runs
+        starts = np.ones(half.shape[0], dtype=np.bool_)
+        starts[1:] = half[1:] != half[:-1]
+        first_of = np.flatnonzero(starts)
+        group = half[first_of]
         count = np.diff(np.append(first_of, key.shape[0]))
         ahead = np.add.reduceat(key % 2, first_of)
         group_block = group % n_blocks
