@@ -126,6 +126,11 @@ def _stable_sort(keys: IntArray) -> tuple[IntArray, IntArray]:
     if n == 0:
         return keys.copy(), np.zeros(0, dtype=np.int64)
     max_key = int(keys.max())
+    bits = (n - 1).bit_length()
+    if int(keys.min()) >= 0 and max_key.bit_length() + bits <= 63:
+        # Bit fields instead of key * n + position: shifts and masks, no int64 divisions.
+        packed = np.sort((keys << bits) | np.arange(n, dtype=np.int64))
+        return packed >> bits, packed & ((1 << bits) - 1)
     if max_key < (_INT64_MAX - n) // n:
         packed = np.sort(keys * n + np.arange(n, dtype=np.int64))
         return packed // n, packed % n
@@ -140,16 +145,26 @@ def _edge_table(faces: IntArray) -> tuple[IntArray, IntArray, IntArray, IntArray
     and ``offsets`` (E + 1,) delimits the groups.
     """
     m, k = faces.shape
+    edges, offsets, perm, first = _edge_groups(faces)
+    inverse = np.empty(perm.shape[0], dtype=np.int64)
+    inverse[perm] = np.cumsum(first) - 1
+    return edges, inverse.reshape(m, k), offsets, perm
+
+
+def _edge_groups(faces: IntArray) -> tuple[IntArray, IntArray, IntArray, BoolArray]:
+    """``(edges, offsets, perm, first)`` of :func:`_edge_table` without the face-edge map;
+    ``first`` marks the sorted sides that start an edge's group."""
     keys, base = _undirected_keys(faces)
     sorted_keys, perm = _stable_sort(keys)
     first = np.ones(sorted_keys.shape[0], dtype=np.bool_)
-    first[1:] = sorted_keys[1:] != sorted_keys[:-1]
-    unique_keys = sorted_keys[first]
-    edges = np.stack([unique_keys // base, unique_keys % base], axis=1)
-    inverse = np.empty(sorted_keys.shape[0], dtype=np.int64)
-    inverse[perm] = np.cumsum(first) - 1
-    offsets = np.append(np.flatnonzero(first), sorted_keys.shape[0]).astype(np.int64)
-    return edges, inverse.reshape(m, k), offsets, perm
+    np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=first[1:])
+    starts = np.flatnonzero(first)
+    unique_keys = np.take(sorted_keys, starts)
+    edges = np.empty((starts.shape[0], 2), dtype=np.int64)
+    np.floor_divide(unique_keys, base, out=edges[:, 0])
+    np.subtract(unique_keys, edges[:, 0] * base, out=edges[:, 1])
+    offsets = np.append(starts, sorted_keys.shape[0]).astype(np.int64, copy=False)
+    return edges, offsets, perm, first
 
 
 # --------------------------------------------------------------------------- faces
@@ -358,8 +373,9 @@ def edge_face_incidence(faces: ArrayLike) -> tuple[IntArray, IntArray, IntArray,
     """
     f = _as_faces(faces, "edge_face_incidence")
     k = f.shape[1]
-    edges, _, offsets, perm = _edge_table(f)
-    return edges, offsets, perm // k, perm % k
+    edges, offsets, perm, _ = _edge_groups(f)
+    face = perm // k
+    return edges, offsets, face, perm - face * k
 
 
 def is_closed(faces: ArrayLike) -> bool:
@@ -485,12 +501,24 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
 
         local = verts - centre
         candidates = _merge_candidates(local, tol)
-        pairs = cKDTree(local[candidates]).query_pairs(r=tol, output_type="ndarray")
-        pairs = candidates[pairs]
-        graph = coo_matrix(
-            (np.ones(pairs.shape[0], dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n)
+        pairs = cKDTree(np.take(local, candidates, axis=0)).query_pairs(
+            r=tol, output_type="ndarray"
         )
-        n_groups, labels = connected_components(graph, directed=False)
+        # Components over the vertices in a pair only (a few): the others stay alone.
+        linked, ends = compact_indices(np.take(candidates, pairs), n)
+        n_linked, linked_labels = 0, np.zeros(0, dtype=np.int64)
+        if linked.size:
+            graph = coo_matrix(
+                (np.ones(ends.shape[0], dtype=np.int8), (ends[:, 0], ends[:, 1])),
+                shape=(linked.shape[0], linked.shape[0]),
+            )
+            n_linked, linked_labels = connected_components(graph, directed=False)
+        alone = np.ones(n, dtype=np.bool_)
+        alone[linked] = False
+        labels = np.empty(n, dtype=np.int64)
+        labels[linked] = linked_labels
+        labels[alone] = n_linked + np.arange(n - linked.shape[0], dtype=np.int64)
+        n_groups = n_linked + n - linked.shape[0]
         first = np.full(n_groups, n, dtype=np.int64)
         np.minimum.at(first, labels, np.arange(n, dtype=np.int64))  # lowest index per group
     # first[g] is the lowest index of group g; renumber groups by that index.
@@ -498,7 +526,7 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
     rank = np.empty(order.shape[0], dtype=np.int64)
     rank[order] = np.arange(order.shape[0], dtype=np.int64)
     representatives = first[order]
-    return verts[representatives].copy(), rank[labels].astype(np.int64, copy=False)
+    return np.take(verts, representatives, axis=0), np.take(rank, labels)
 
 
 def part_vertices(faces: ArrayLike, labels: ArrayLike | None, n_vertices: int) -> list[IntArray]:

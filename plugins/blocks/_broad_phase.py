@@ -170,8 +170,11 @@ def overlapping_pairs(
 def component_major(columns: FloatArray, triangles: IntArray) -> FloatArray:
     """Corners of ``triangles`` (K, 3) over vertex ``columns`` (3, V), stored component-major
     as :func:`stored_pairs` takes them: (corner, xyz, K)."""
-    taken = np.take(columns, np.ascontiguousarray(triangles.T), axis=1)  # (xyz, corner, K)
-    return np.asarray(taken.transpose(1, 0, 2), dtype=np.float64)
+    by_corner = np.ascontiguousarray(triangles.T)
+    stored = np.empty((3, 3, triangles.shape[0]), dtype=np.float64)
+    for k in range(3):
+        np.take(columns, by_corner[k], axis=1, out=stored[k])
+    return stored
 
 
 def stored_pairs(

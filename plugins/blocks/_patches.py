@@ -79,14 +79,9 @@ def split_patches(soup: Soup) -> PatchSplit:
         (np.ones(int(manifold.sum()), dtype=np.int8), (t1[manifold], t2[manifold])),
         shape=(n_triangles, n_triangles),
     )
-    _, labels = connected_components(graph, directed=False)
-    # Renumber components by their first triangle: patches follow surface order.
-    _, first_triangle = np.unique(labels, return_index=True)
-    order = np.argsort(first_triangle, kind="stable")
-    rank = np.empty(order.shape[0], dtype=np.int64)
-    rank[order] = np.arange(order.shape[0], dtype=np.int64)
-    triangle_patch = rank[labels].astype(np.int64, copy=False)
-    patch_surface = soup.triangle_surface[first_triangle[order]]
+    n_components, labels = connected_components(graph, directed=False)
+    triangle_patch, first_triangle = _by_first_triangle(labels.astype(np.int64), n_components)
+    patch_surface = soup.triangle_surface[first_triangle]
     surface_start = np.searchsorted(patch_surface, patch_surface, side="left")
     patch_label = np.arange(patch_surface.shape[0], dtype=np.int64) - surface_start
     return PatchSplit(
@@ -100,3 +95,20 @@ def split_patches(soup: Soup) -> PatchSplit:
         patch_label=patch_label,
         orientation_seams=int((same_surface & ~consistent).sum()),
     )
+
+
+def _by_first_triangle(labels: IntArray, n_labels: int) -> tuple[IntArray, IntArray]:
+    """Component labels renumbered by their first triangle (patches follow surface order), and
+    the first triangle of each. Labels that already come in that order (the running maximum
+    grows by one at a time) are kept as they are, without a sort."""
+    if labels.size == 0:
+        return labels, labels
+    running = np.maximum.accumulate(labels)
+    steps = np.diff(running, prepend=-1)
+    if int(steps.max()) <= 1 and int(running[-1]) == n_labels - 1:
+        return labels, np.flatnonzero(steps)
+    _, first_triangle = np.unique(labels, return_index=True)
+    order = np.argsort(first_triangle, kind="stable")
+    rank = np.empty(order.shape[0], dtype=np.int64)
+    rank[order] = np.arange(order.shape[0], dtype=np.int64)
+    return np.take(rank, labels), first_triangle[order]
