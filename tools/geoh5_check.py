@@ -55,10 +55,13 @@ def write_step(folder: Path) -> None:
         sizes=(np.full(4, 25.0), np.full(3, 50.0), np.full(2, 10.0)),
     )
     blocks = grid.point_set("grade model", point_data={"grade": np.arange(24.0)})
-    scene = geobrep.Scene(entities=[*surfaces, wells, trace, blocks], name="check")
+    well = _well()
+    scene = geobrep.Scene(entities=[*surfaces, wells, trace, blocks, well], name="check")
     geobrep.write(scene, folder / "geobrep.geoh5")
-    expected: dict[str, Any] = {}
+    expected: dict[str, Any] = _well_expected(well)
     for entity in scene.entities:
+        if entity.type == "Well":
+            continue
         if entity.name == blocks.name:
             expected[f"{entity.name}|grade"] = _geoh5_order_values(
                 grid, entity.point_data["grade"].values
@@ -78,20 +81,154 @@ def write_step(folder: Path) -> None:
     print(f"geobrep wrote {len(scene.entities)} objects to {folder / 'geobrep.geoh5'}")
 
 
+def _well() -> Any:
+    """A deviated well (minimum curvature, turning in azimuth) with logs, markers and zones."""
+    import geobrep
+    from geobrep.geometry.trajectory import minimum_curvature
+    from geobrep.model.entities import WellLog, WellMarker, WellZone
+
+    md = np.arange(0.0, 1501.0, 100.0)
+    head = np.array([450100.0, 6700200.0, 120.0])
+    stations = head + minimum_curvature(md, np.clip(md / 30.0, 0.0, 40.0), 20.0 + md / 25.0)
+    rng = np.random.default_rng(3)
+    return geobrep.Well(
+        name="W-1",
+        head=head,
+        vertices=stations,
+        md=md,
+        markers=[
+            WellMarker(name="H1 pick", md=412.5, surface="H1"),
+            WellMarker(name="F1 pick", md=412.5, surface="F1"),
+            WellMarker(name="H2 pick", md=980.0, surface="H2"),
+        ],
+        zones=[
+            WellZone(name="U1", top_md=412.5, base_md=980.0),
+            WellZone(name="U2", top_md=980.0, base_md=1500.0),
+        ],
+        logs={
+            "GR": WellLog(md=np.arange(5.0, 1495.0, 0.5), values=rng.normal(80.0, 9.0, 2980)),
+            "FACIES": WellLog(
+                md=np.arange(100.0, 1400.0, 12.5), values=(np.arange(104) % 3).astype(np.int32)
+            ),
+        },
+    )
+
+
+def _well_expected(well: Any) -> dict[str, Any]:
+    """What geoh5py must find of the well: collar, float32 surveys, where geoh5's desurveying
+    puts the stations' depths (geobrep's port of it), logs, markers and zones."""
+    from geobrep.adapters.geoh5._desurvey import desurvey, station_surveys
+
+    rows = station_surveys(well.vertices, well.md)
+    table = np.column_stack([rows[k] for k in ("Depth", "Azimuth", "Dip")]).astype(np.float64)
+    found = {
+        "well|collar": np.asarray(well.head),
+        "well|surveys": table,
+        "well|md": well.md,
+        "well|desurvey": desurvey(well.head, table, float(well.md[-1]), well.md),
+        "well|markers": np.array([f"{m.name}@{m.md}@{m.surface}" for m in well.markers]),
+        "well|zones": np.array([f"{z.name}@{z.top_md}@{z.base_md}" for z in well.zones]),
+    }
+    for name, log in well.logs.items():
+        found[f"well|log|{name}|md"], found[f"well|log|{name}|values"] = log.md, log.values
+    return found
+
+
 def _geoh5_order_values(grid: Any, values: Any) -> Any:
     nu, nv, nw = grid.shape
     v, u, w = np.meshgrid(np.arange(nv), np.arange(nu), np.arange(nw), indexing="ij")
     return np.asarray(values)[(u + nu * (v + nv * w)).ravel()]
 
 
+def _close(name: str, got: Any, want: Any, metres: float = 1e-6) -> None:
+    got, want = np.asarray(got, dtype=float), np.asarray(want, dtype=float)
+    if got.shape != want.shape or not np.allclose(got, want, rtol=0.0, atol=metres):
+        _fail(f"{name}: {got.shape} positions differ from {want.shape} by more than {metres} m")
+
+
+def _picks(depth: Any, names: Any, keys: Any, surfaces: Any = None) -> Any:
+    """``name@depth@surface`` of each keyed row (``obj``'s value maps name the keys)."""
+    rows = np.flatnonzero(np.asarray(keys) > 0)
+    surface = [surfaces.value_map()[k] if k else "" for k in surfaces.values] if surfaces else None
+    return np.array(
+        [f"{names[int(keys[r])]}@{float(depth[r])}@{surface[r] if surface else ''}" for r in rows]
+    )
+
+
+def _check_drillhole(obj: Any, expected: Any) -> int:
+    """geoh5py's view of geobrep's well: collar, surveys, desurveying, logs, markers, zones."""
+    collar = [obj.collar["x"], obj.collar["y"], obj.collar["z"]]
+    _same("well collar", np.asarray(collar, dtype=float).ravel(), expected["well|collar"])
+    _same("well surveys", obj.surveys, expected["well|surveys"])
+    _close("well desurvey", obj.desurvey(expected["well|md"]), expected["well|desurvey"])
+    data = {d.name: d for d in obj.children}
+    depth = np.asarray(data["DEPTH"].values)
+    compared = 4
+    for name in [k.split("|")[2] for k in expected.files if k.endswith("|values")]:
+        values = np.asarray(data[name].values)
+        kept = ~np.isnan(values) if values.dtype.kind == "f" else values != data[name].ndv
+        _same(f"well {name} depths", depth[kept], expected[f"well|log|{name}|md"])
+        _same(f"well {name} values", values[kept], expected[f"well|log|{name}|values"])
+        compared += 2
+    marker = data["MARKER"]
+    markers = _picks(depth, marker.value_map(), marker.values, data["MARKER SURFACE"])
+    _same("well markers", markers, expected["well|markers"])
+    zone = data["ZONE"]
+    tops, bases = data["FROM"].values, data["TO"].values
+    zones = [
+        f"{zone.value_map()[int(k)]}@{t}@{b}"
+        for k, t, b in zip(zone.values, tops, bases, strict=True)
+    ]
+    _same("well zones", np.array(zones), expected["well|zones"])
+    return compared + 2
+
+
+def _geoh5py_drillhole(workspace: Any) -> dict[str, Any]:
+    """A drillhole as geoh5py writes one (surveys, a depth log, referenced intervals) and what
+    geoh5py says it holds: the desurveyed stations, the log and the intervals."""
+    from geoh5py.objects import Drillhole
+
+    surveys = np.array([[0.0, 45, -90], [150, 50, -80], [400, 70, -60], [700, 90, -50]])
+    hole = Drillhole.create(
+        workspace, name="dh", collar=np.array([450500.0, 6700600, 95]), surveys=surveys
+    )
+    hole.end_of_hole = 800.0
+    depth = np.arange(2.0, 790.0, 1.5)
+    intervals = np.array([[10.0, 120.0], [120.0, 300.5], [300.5, 640.0]])
+    hole.add_data(
+        {
+            "gr": {"values": 60 + 50 * np.sin(depth / 20), "depth": depth},
+            "litho": {
+                "type": "referenced",
+                "values": np.array([1, 2, 1], dtype=np.int32),
+                "value_map": {1: "sand", 2: "shale"},
+                "from-to": intervals,
+            },
+        }
+    )
+    md = np.unique(np.r_[0.0, hole.surveys[:, 0], hole.end_of_hole])
+    return {
+        "dh|md": md,
+        "dh|stations": hole.desurvey(md),
+        "dh|gr depth": depth,
+        "dh|gr": hole.get_data("gr")[0].values[~np.isnan(hole.get_data("gr")[0].values)],
+        "dh|zones": np.array(
+            [f"{n}@{t}@{b}" for n, (t, b) in zip(["sand", "shale", "sand"], intervals, strict=True)]
+        ),
+    }
+
+
 def geoh5py_step(folder: Path) -> None:
-    from geoh5py.objects import BlockModel, Curve, Points, Surface
+    from geoh5py.objects import BlockModel, Curve, Drillhole, Points, Surface
     from geoh5py.workspace import Workspace
 
     expected = np.load(folder / "geobrep-expected.npz")
     compared = 0
     with Workspace(folder / "geobrep.geoh5", mode="r") as workspace:
         for obj in workspace.objects:
+            if isinstance(obj, Drillhole):
+                compared += _check_drillhole(obj, expected)
+                continue
             if getattr(obj, "vertices", None) is not None:
                 _same(f"{obj.name} vertices", obj.vertices, expected[f"{obj.name}|vertices"])
                 compared += 1
@@ -146,6 +283,7 @@ def geoh5py_step(folder: Path) -> None:
         found["crv|cells"] = curve.cells
         found["bm|centroids"] = model.centroids
         found["bm|rho"] = model.children[0].values
+        found.update(_geoh5py_drillhole(workspace))
     np.savez(folder / "geoh5py-expected.npz", **found)
     print(f"geoh5py wrote {target}")
 
@@ -168,7 +306,14 @@ def read_step(folder: Path) -> None:
     ours = np.column_stack([bm.vertices, bm.point_data["rho"].values])
     theirs = np.column_stack([expected["bm|centroids"], expected["bm|rho"]])
     _same("bm cells", ours[np.lexsort(ours.T)], theirs[np.lexsort(theirs.T)])
-    print("geobrep read what geoh5py wrote: 4 objects, all arrays equal")
+    dh = scene["dh"]
+    _same("dh md", dh.md, expected["dh|md"])
+    _close("dh stations", dh.vertices, expected["dh|stations"], metres=1e-9)
+    _same("dh gr depth", dh.logs["gr"].md, expected["dh|gr depth"])
+    _same("dh gr", dh.logs["gr"].values, expected["dh|gr"])
+    zones = [f"{z.name}@{z.top_md}@{z.base_md}" for z in dh.zones]
+    _same("dh zones", np.array(zones), expected["dh|zones"])
+    print("geobrep read what geoh5py wrote: 5 objects, all arrays equal")
 
 
 if __name__ == "__main__":

@@ -1,10 +1,12 @@
 """geoh5 (Mira Geoscience ANALYST, format version 2) on h5py: ``.geoh5`` workspaces.
 
 Written from the published geoh5 schema, not through geoh5py (which pins ``numpy<1.27``):
-Points, Curve, Surface and BlockModel objects with their vertex and cell data, both ways,
-float64 coordinates exactly. A block model reads as a ``RegularGrid`` (or, when its cell sizes
-vary, as a point set of its cell centres standing for the grid, ``metadata["grid"]``) and writes
-back as the same block model.
+Points, Curve, Surface, BlockModel and Drillhole objects with their vertex and cell data, both
+ways, float64 coordinates exactly. A drillhole is a ``Well``: its collar, surveys (float32 dip and
+azimuth at depth) and stations, logs as depth data, markers as referenced depth data and zones
+as referenced interval data (``_drillhole``). A block model reads as a ``RegularGrid`` (or, when
+its cell sizes vary, as a point set of its cell centres standing for the grid,
+``metadata["grid"]``) and writes back as the same block model.
 ``make geoh5-check`` cross-checks the files with geoh5py in an environment of its own. Needs
 h5py (the ``geoh5`` extra).
 
@@ -27,14 +29,14 @@ from geobrep.adapters._file_format import file_format
 from geobrep.errors import FormatError, import_optional
 from geobrep.hookspecs import hookimpl
 from geobrep.host.registry import FormatCapabilities, FormatRegistry, NoOptions
-from geobrep.model.entities import RegularGrid
+from geobrep.model.entities import RegularGrid, Well
 from geobrep.model.scene import Scene
 
 __all__ = ["CAPABILITIES", "geobrep_register_formats"]
 
 #: What a geoh5 workspace written by geobrep holds.
 CAPABILITIES = FormatCapabilities(
-    entity_types=frozenset({"PointSet", "PolyLine", "Surface", "RegularGrid"}),
+    entity_types=frozenset({"PointSet", "PolyLine", "Surface", "RegularGrid", "Well"}),
     point_data=True,
     cell_data=True,
     names=True,
@@ -59,7 +61,10 @@ def _write(scene: Scene, path: Path, options: NoOptions) -> None:
 
 
 def _losses(scene: Scene, path: Path) -> list[str]:
-    """Kinds, metadata, patch labels, vector properties and property details."""
+    """Kinds, metadata, patch labels, vector properties, property details and what a
+    drillhole does not hold of a well."""
+    from geobrep.adapters.geoh5._well_losses import well_losses
+
     lost = []
     kinds = [e.label for e in scene.entities if e.kind]
     if kinds:
@@ -76,7 +81,11 @@ def _losses(scene: Scene, path: Path) -> list[str]:
             lost.append(
                 f"{grid.label}: point properties dropped: {names} (block models hold cell data)"
             )
+    for well in scene.of_type(Well):
+        lost.extend(well_losses(well))
     for entity in scene.entities:
+        if isinstance(entity, Well):
+            continue
         for field in ("point_data", "cell_data"):
             if entity.type == "RegularGrid" and field == "point_data":
                 continue
@@ -101,7 +110,8 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
     registry.add(
         file_format(
             "geoh5",
-            "geoh5 workspace (Geoscience ANALYST, on h5py): points, curves, surfaces, block models",
+            "geoh5 workspace (Geoscience ANALYST, on h5py): points, curves, surfaces, block "
+            "models, drillholes",
             (".geoh5",),
             capabilities=CAPABILITIES,
             options=NoOptions,

@@ -11,7 +11,6 @@ delimiters along u, v and z, cells ordered v slowest, z fastest) are read and wr
 from __future__ import annotations
 
 import math
-import uuid
 from pathlib import Path
 from typing import Any
 
@@ -21,30 +20,29 @@ from numpy.typing import NDArray
 
 from geobrep.adapters._grid_cells import Grid, as_grid, cell_values, grid_entity, triple
 from geobrep.adapters.cell_layout import chain_segments
+from geobrep.adapters.geoh5._drillhole import read_drillhole, write_drillhole
+from geobrep.adapters.geoh5._schema import (
+    ENTITY_FLAGS,
+    OBJECT_TYPES,
+    XYZ,
+    add_data,
+    object_type,
+    text,
+    uid,
+    vertex_rows,
+    xyz,
+)
 from geobrep.adapters.limits import check_declared
 from geobrep.errors import FormatError, GeobrepError
 from geobrep.host.capabilities import SKIPPED_ON_READ
-from geobrep.model.entities import Entity, PointSet, PolyLine, Surface
+from geobrep.model.entities import Entity, PointSet, PolyLine, Surface, Well
 from geobrep.model.properties import PropertyMap
 from geobrep.model.scene import Scene
 
-__all__ = ["OBJECT_TYPES", "read_geoh5", "write_geoh5"]
+__all__ = ["read_geoh5", "write_geoh5"]
 
-#: geoh5 object type uuids (fixed by the schema) and names.
-OBJECT_TYPES = {
-    "Points": "{202C5DB1-A56D-4004-9CAD-BAAFD8899406}",
-    "Curve": "{6A057FDC-B355-11E3-95BE-FD84A7FFCB88}",
-    "Surface": "{F26FEBA3-ADED-494B-B9E9-B2BBCBE298E1}",
-    "Block model": "{B020A277-90E2-4CD7-84D6-612EE3F25051}",
-}
 _BY_TYPE = {v.lower(): k for k, v in OBJECT_TYPES.items()}
 _ROOT_TYPE = "{dd99b610-be92-48c0-873c-5b5946ea2840}"
-_ENTITY_FLAGS = {"Allow delete": 1, "Allow move": 1, "Allow rename": 1, "Public": 1, "Visible": 1}
-_XYZ = np.dtype([("x", "<f8"), ("y", "<f8"), ("z", "<f8")])
-
-
-def _uid() -> str:
-    return "{" + str(uuid.uuid4()) + "}"
 
 
 # -- writing ------------------------------------------------------------------------------------
@@ -63,9 +61,9 @@ def _workspace(store: h5py.File, name: str) -> h5py.Group:
         "Types/Object types",
     ):
         root.create_group(folder, track_order=True)  # objects read back in the order written
-    ident = _uid()
+    ident = uid()
     group = root["Groups"].create_group(ident)
-    group.attrs.update({"ID": ident, "Name": name or "Workspace", **_ENTITY_FLAGS})
+    group.attrs.update({"ID": ident, "Name": name or "Workspace", **ENTITY_FLAGS})
     for folder in ("Data", "Groups", "Objects"):
         group.create_group(folder, track_order=True)
     kind = root["Types/Group types"].create_group(_ROOT_TYPE)
@@ -75,41 +73,13 @@ def _workspace(store: h5py.File, name: str) -> h5py.Group:
     return root
 
 
-def _object_type(root: h5py.Group, name: str) -> h5py.Group:
-    ident = OBJECT_TYPES[name]
-    types = root["Types/Object types"]
-    if ident not in types:
-        types.create_group(ident).attrs.update({"ID": ident, "Name": name, "Description": name})
-    return types[ident]
-
-
 def _write_data(root: h5py.Group, obj: h5py.Group, props: PropertyMap, association: str) -> None:
     for name, prop in props.items():
         values = np.asarray(prop.values)
         if values.ndim != 1 or values.dtype.kind not in "biuf":
             continue  # vectors: reported as lost
-        primitive = "Float" if values.dtype.kind == "f" else "Integer"
-        stored = np.asarray(values, dtype=np.float64 if primitive == "Float" else np.int32)
-        ident, type_ident = _uid(), _uid()
-        data = root["Data"].create_group(ident)
-        data.attrs.update({"ID": ident, "Name": name, "Association": association, **_ENTITY_FLAGS})
-        data.create_dataset("Data", data=stored)
-        kind = root["Types/Data types"].create_group(type_ident)
-        kind.attrs.update(
-            {
-                "ID": type_ident,
-                "Name": name,
-                "Description": prop.description or name,
-                "Primitive type": primitive,
-            }
-        )
-        data["Type"] = kind
-        obj["Data"][ident] = data
-
-
-def _vertices(points: NDArray[np.float64]) -> NDArray[Any]:
-    """``(N, 3)`` float64 points as geoh5's x, y, z records (a view when they are C-ordered)."""
-    return np.ascontiguousarray(points, dtype="<f8").view(_XYZ).reshape(-1)
+        stored = np.asarray(values, dtype=np.float64 if values.dtype.kind == "f" else np.int32)
+        add_data(root, obj, name, association, stored, description=prop.description)
 
 
 def _rotation(grid: Grid) -> float:
@@ -129,18 +99,20 @@ def _write_object(root: h5py.Group, entity: Entity) -> None:
     kind = (
         "Block model"
         if grid
-        else {"Surface": "Surface", "PolyLine": "Curve"}.get(entity.type, "Points")
+        else {"Surface": "Surface", "PolyLine": "Curve", "Well": "Drillhole"}.get(
+            entity.type, "Points"
+        )
     )
-    ident = _uid()
+    ident = uid()
     obj = root["Objects"].create_group(ident)
     obj.attrs.update(
-        {"ID": ident, "Name": entity.name or entity.label, "Last focus": "None", **_ENTITY_FLAGS}
+        {"ID": ident, "Name": entity.name or entity.label, "Last focus": "None", **ENTITY_FLAGS}
     )
     obj.create_group("Data", track_order=True)
-    obj["Type"] = _object_type(root, kind)
+    obj["Type"] = object_type(root, kind)
     root["Root"]["Objects"][ident] = obj
     if grid is not None:
-        origin = np.array([tuple(grid.origin)], dtype=_XYZ)[0]
+        origin = np.array([tuple(grid.origin)], dtype=XYZ)[0]
         obj.attrs["Origin"] = origin
         obj.attrs["Rotation"] = _rotation(grid)
         for axis, sizes in zip("UVZ", grid.sizes, strict=True):
@@ -154,8 +126,11 @@ def _write_object(root: h5py.Group, entity: Entity) -> None:
         }
         _write_data(root, obj, PropertyMap(values), "Cell")
         return
+    if isinstance(entity, Well):
+        write_drillhole(root, obj, entity)
+        return
     assert isinstance(entity, PointSet | PolyLine | Surface)
-    obj.create_dataset("Vertices", data=_vertices(entity.vertices))
+    obj.create_dataset("Vertices", data=vertex_rows(entity.vertices))
     if isinstance(entity, Surface):
         obj.create_dataset("Cells", data=np.asarray(entity.faces, dtype=np.int32))
     elif isinstance(entity, PolyLine):
@@ -188,10 +163,6 @@ def write_geoh5(scene: Scene, path: Path) -> None:
 # -- reading ------------------------------------------------------------------------------------
 
 
-def _text(value: Any) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
 def _check_sizes(store: h5py.File, path: Path) -> None:
     total = 0
 
@@ -207,28 +178,19 @@ def _check_sizes(store: h5py.File, path: Path) -> None:
 def _read_data(obj: h5py.Group, association: str, n: int, order: Any = None) -> PropertyMap:
     found = {}
     for data in obj.get("Data", {}).values():
-        if _text(data.attrs.get("Association", "")) != association or "Data" not in data:
+        if text(data.attrs.get("Association", "")) != association or "Data" not in data:
             continue
         values = np.asarray(data["Data"][()])
         if values.ndim != 1 or values.dtype.kind not in "biuf" or len(values) != n:
             continue
         kind = data.get("Type")
-        description = "" if kind is None else _text(kind.attrs.get("Description", ""))
-        name = _text(data.attrs.get("Name", ""))
+        description = "" if kind is None else text(kind.attrs.get("Description", ""))
+        name = text(data.attrs.get("Name", ""))
         found[name] = {
             "values": values if order is None else values[order],
             "description": "" if description in (name, "Entity") else description,
         }
     return PropertyMap(found)
-
-
-def _xyz(obj: h5py.Group) -> NDArray[np.float64]:
-    rows: NDArray[Any] = obj["Vertices"][()]
-    if rows.dtype == _XYZ:  # geobrep's and geoh5py's records: the floats as they lie
-        return rows.view("<f8").reshape(-1, 3).astype(np.float64, copy=False)
-    if rows.dtype.names:
-        return np.column_stack([rows[k] for k in ("x", "y", "z")]).astype(np.float64)
-    return np.asarray(rows, dtype=np.float64).reshape(-1, 3)
 
 
 def _block_model(obj: h5py.Group, name: str, ident: int) -> Entity:
@@ -248,16 +210,19 @@ def _block_model(obj: h5py.Group, name: str, ident: int) -> Entity:
     return grid_entity(grid, name, cells, {}, id=ident)
 
 
-def _object(obj: h5py.Group, ident: int) -> Entity | None:
+def _object(obj: h5py.Group, ident: int, skipped: list[str]) -> Entity | None:
     """The entity of ``obj`` with id ``ident`` (given here: a Scene giving ids would validate
-    each entity again), or None for a type geobrep does not read."""
-    kind = _BY_TYPE.get(_text(obj["Type"].attrs.get("ID", "")).lower())
-    name = _text(obj.attrs.get("Name", ""))
+    each entity again), or None for a type geobrep does not read; what it holds and geobrep
+    does not read goes to ``skipped``."""
+    kind = _BY_TYPE.get(text(obj["Type"].attrs.get("ID", "")).lower())
+    name = text(obj.attrs.get("Name", ""))
     if kind == "Block model":
         return _block_model(obj, name, ident)
+    if kind == "Drillhole":
+        return read_drillhole(obj, name, ident, skipped)
     if kind is None or "Vertices" not in obj:
         return None
-    vertices = _xyz(obj)
+    vertices = xyz(obj["Vertices"][()])
     points = _read_data(obj, "Vertex", len(vertices))
     if kind == "Points":
         return PointSet(vertices=vertices, name=name, point_data=points, id=ident)
@@ -293,15 +258,15 @@ def read_geoh5(path: Path) -> Scene:
             skipped: list[str] = []
             for ident, obj in root.get("Objects", {}).items():
                 try:
-                    entity = _object(obj, len(entities))
+                    entity = _object(obj, len(entities), skipped)
                 except GeobrepError as exc:
                     raise FormatError(f"object {ident}: {exc}", path) from exc
                 if entity is None:
-                    label = _text(obj.attrs.get("Name", ident))
+                    label = text(obj.attrs.get("Name", ident))
                     skipped.append(f"geoh5 object {label!r}: no reader for its type")
                 else:
                     entities.append(entity)
-            name = _text(root["Root"].attrs.get("Name", path.stem)) if "Root" in root else path.stem
+            name = text(root["Root"].attrs.get("Name", path.stem)) if "Root" in root else path.stem
     except GeobrepError:
         raise
     except Exception as exc:  # h5py and damaged attributes
