@@ -1,9 +1,12 @@
 """GOCAD formats: TSurf (.ts), PLine (.pl), VSet (.vs), TSolid (.so), Model3d (.ml), groups,
-Voxet (.vo) and SGrid (.sg), with their side files, and Well (.wl).
+Voxet (.vo) and SGrid (.sg), with their side files, and Well (.wl); and SKUA horizon stacks
+(.xml).
 
-One format, ``gocad``, covers the family: the reader recognises each object by its
+One format, ``gocad``, covers the GOCAD ASCII family: the reader recognises each object by its
 ``GOCAD <Type>`` line (so a .ts holding a PLine still reads), the writer picks the object type
-from the extension (see :mod:`geobrep.adapters.gocad._writer`). Registered through
+from the extension (see :mod:`geobrep.adapters.gocad._writer`). The ``skua`` format reads and
+writes the stratigraphic columns of SKUA's ``<UserObjects>`` XML as the scene's groups (.xml is
+shared: its sniffer looks at the root element). Registered through
 ``geobrep_register_formats`` like any third-party format.
 """
 
@@ -12,7 +15,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from geobrep.hookspecs import hookimpl
-from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec
+from geobrep.host.registry import FormatCapabilities, FormatRegistry, FormatSpec, NoOptions
 from geobrep.model.scene import Scene
 
 __all__ = ["EXTENSIONS", "geobrep_register_formats", "looks_like_gocad"]
@@ -71,6 +74,35 @@ _FAMILY = frozenset(
 )
 
 
+def _read_stack(path: Path, options: object) -> Scene:
+    from geobrep.adapters.gocad._horizons_stack import read_horizons_stack
+
+    return read_horizons_stack(path)
+
+
+def _write_stack(scene: Scene, path: Path, options: object) -> None:
+    from geobrep.adapters.gocad._horizons_stack import write_horizons_stack
+    from geobrep.host.capabilities import restrict_scene
+
+    write_horizons_stack(restrict_scene(scene, _STACK_CAPABILITIES), path, options)
+
+
+def _stack_losses(scene: Scene, path: Path) -> list[str]:
+    from geobrep.adapters.gocad._horizons_stack import stack_losses
+
+    return stack_losses(scene, path)
+
+
+def _looks_like_stack(head: bytes) -> bool:
+    from geobrep.adapters.gocad._horizons_stack import looks_like_horizons_stack
+
+    return looks_like_horizons_stack(head)
+
+
+#: A horizon stack holds groups only (names of horizons and units), no entities.
+_STACK_CAPABILITIES = FormatCapabilities(entity_types=frozenset(), names=True)
+
+
 def _grid_losses(scene: Scene, path: Path) -> list[str]:
     """What a Voxet or Well file cannot hold of the one entity it keeps."""
     from geobrep.model.entities import RegularGrid, StructuredGrid, Well
@@ -125,7 +157,7 @@ def _losses(scene: Scene, path: Path) -> list[str]:
 
 @hookimpl
 def geobrep_register_formats(registry: FormatRegistry) -> None:
-    """Register the ``gocad`` format (.ts .pl .vs .so .ml .gp .vo .sg .wl)."""
+    """Register the ``gocad`` format (.ts .pl .vs .so .ml .gp .vo .sg .wl) and ``skua`` (.xml)."""
     from geobrep.adapters.gocad.options import GocadOptions
 
     registry.add(
@@ -149,5 +181,18 @@ def geobrep_register_formats(registry: FormatRegistry) -> None:
                 empty_entities=True,
             ),
             losses=_losses,
+        )
+    )
+    registry.add(
+        FormatSpec(
+            name="skua",
+            description="SKUA horizon stack: the order of horizons and units as groups",
+            extensions=(".xml",),
+            reader=_read_stack,
+            writer=_write_stack,
+            sniff=_looks_like_stack,
+            options=NoOptions,
+            capabilities=_STACK_CAPABILITIES,
+            losses=_stack_losses,
         )
     )

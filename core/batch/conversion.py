@@ -86,6 +86,8 @@ class FileReport(BaseModel):
     """What the target format could not hold (empty: nothing was dropped)."""
     error: str | None = None
     entities: int = 0
+    columns: int = 0
+    """Stratigraphic columns (groups) written: a horizon stack holds no entities."""
     seconds: float = 0.0
 
 
@@ -99,6 +101,9 @@ class StepReport(BaseModel):
     kind: str
     entities: int = 0
     """Entities in the scene after the step."""
+    columns: int = 0
+    """Stratigraphic columns in the scene after the step (groups of kind
+    ``stratigraphic_column``)."""
     seconds: float = 0.0
     notes: tuple[str, ...] = ()
     """What the step wants known: fit accuracy, octree size, what an output format drops."""
@@ -262,6 +267,7 @@ def convert_one(pipeline: Pipeline, source: Path, target: Path, contain: bool = 
         status="converted",
         lost=tuple(loss.removeprefix(prefix) for loss in report.lost),
         entities=report.steps[-1].entities if report.steps else 0,
+        columns=report.steps[-1].columns if report.steps else 0,
         seconds=report.seconds,
     )
 

@@ -302,6 +302,7 @@ def run_steps(
                     step=work.number,
                     kind=work.kind,
                     entities=sum(len(scene.entities) for _, scene in branches),
+                    columns=sum(len(scene.stratigraphic_columns) for _, scene in branches),
                     seconds=time.perf_counter() - begun,
                     notes=tuple(notes),
                 )
@@ -535,7 +536,7 @@ def _operation(step: OperationStep, scene: Scene, work: _Work) -> Applied:
 
 def _write(step: OutputStep, scene: Scene, work: _Work) -> Applied:
     target = work.targets[len(work.pending)]
-    if scene.bounds is None and not step.allow_empty:  # nothing with geometry in it
+    if scene.holds_nothing and not step.allow_empty:  # no geometry, no stratigraphic column
         raise GeobrepError(
             f"{target.name}: the result holds nothing to write (a clip or section that misses "
             "the model?); give the write step allow_empty: true (geobrep run --allow-empty) to "

@@ -339,7 +339,8 @@ class EmptyResultError(Exception):
 
 
 def is_empty(data: Scene | Entity | Iterable[Entity] | None) -> bool:
-    """True when nothing in ``data`` has geometry (no entity, or only empty ones)."""
+    """True when nothing in ``data`` has geometry (no entity, or only empty ones) and it holds no
+    stratigraphic column (:attr:`~geobrep.Scene.holds_nothing`)."""
     from geobrep.model.entities import Entity
     from geobrep.model.scene import Scene
 
@@ -348,7 +349,7 @@ def is_empty(data: Scene | Entity | Iterable[Entity] | None) -> bool:
     if isinstance(data, Entity):
         return data.bounds is None
     scene = data if isinstance(data, Scene) else Scene(entities=list(data))
-    return scene.bounds is None
+    return scene.holds_nothing
 
 
 def refuse_empty(

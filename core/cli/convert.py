@@ -148,7 +148,9 @@ def run(step: ConvertStep, command: ConvertCommand) -> int:
     if not summary.ok:
         return 1
     empty = [
-        f"{r.target}: nothing read from {r.source}" for r in summary.converted if not r.entities
+        f"{r.target}: nothing read from {r.source}"
+        for r in summary.converted
+        if not r.entities and not r.columns
     ]
     refuse_empty(command, empty, consequence="the file holds nothing")
     return 0

@@ -24,7 +24,7 @@ from geobrep.model.entities import (
     Well,
 )
 from geobrep.model.properties import PropertyMap
-from geobrep.model.scene import Scene
+from geobrep.model.scene import Group, Scene
 from geobrep.ops.io import read
 
 __all__ = ["add_parser", "describe_entity", "describe_scene"]
@@ -188,6 +188,17 @@ def describe_scene(scene: Scene) -> dict[str, Any]:
             "universe": scene.universe is not None,
         },
         "groups": [g.name for g in scene.groups],
+        "stratigraphic_columns": [_column(c) for c in scene.stratigraphic_columns],
+    }
+
+
+def _column(column: Group) -> dict[str, Any]:
+    """A stratigraphic column's horizons and units, top down."""
+    parts = {c.kind: [g.name for g in c.children] for c in column.children}
+    return {
+        "name": column.name,
+        "horizons": parts.get("horizons", []),
+        "units": parts.get("stratigraphic_units", []),
     }
 
 
@@ -221,6 +232,14 @@ def render_text(summary: dict[str, Any], source: str) -> str:
             f"{topo['patches']} patches, {topo['blocks']} blocks"
             + (" + universe" if topo["universe"] else "")
         )
+    for column in summary.get("stratigraphic_columns", []):
+        horizons, units = column["horizons"], column["units"]
+        lines.append(
+            f"  stratigraphic column {column['name']!r}: {len(horizons)} horizons, "
+            f"{len(units)} units (top down)"
+        )
+        lines.append(f"      horizons {', '.join(horizons) or '-'}")
+        lines.append(f"      units    {', '.join(units) or '-'}")
     for entity in summary["entities"]:
         counts = ", ".join(f"{v} {k}" for k, v in entity["counts"].items())
         kind = f" [{entity['kind']}]" if entity["kind"] else ""

@@ -40,13 +40,18 @@ from geobrep.model.entities import (
 )
 from geobrep.model.topology import Patch, Topology
 
-__all__ = ["Group", "Scene"]
+__all__ = ["STRATIGRAPHIC_COLUMN", "Group", "Scene"]
 
 E = TypeVar("E", bound=Entity)
 
 #: Default tolerance for joining coincident vertices of different surfaces, relative to the
 #: diagonal of the model's bounding box.
 RELATIVE_MERGE_TOLERANCE = 1e-9
+
+STRATIGRAPHIC_COLUMN = "stratigraphic_column"
+"""The kind of a group that is a stratigraphic column (a SKUA horizon stack): its children are a
+group of kind ``horizons`` and one of kind ``stratigraphic_units``, each listing theirs top down
+(see docs/grids-wells-rasters.md)."""
 
 
 class Group(FrozenModel):
@@ -288,6 +293,18 @@ class Scene(FrozenModel):
     @property
     def patches(self) -> tuple[Patch, ...]:
         return self.topology.patches
+
+    @property
+    def stratigraphic_columns(self) -> tuple[Group, ...]:
+        """The groups of kind :data:`STRATIGRAPHIC_COLUMN`, anywhere in the group tree."""
+        return tuple(
+            g for root in self.groups for g in root.walk() if g.kind == STRATIGRAPHIC_COLUMN
+        )
+
+    @property
+    def holds_nothing(self) -> bool:
+        """True when no entity has geometry and there is no stratigraphic column."""
+        return self.bounds is None and not self.stratigraphic_columns
 
     # -- geometry -------------------------------------------------------------------------------
     @cached_property
