@@ -59,9 +59,8 @@ def neighbour_pairs(
     first = offsets[:-1][counts == 2]
     side_a, side_b = perm[first], perm[first + 1]
     face_a, face_b = side_a // k, side_b // k
-    start_a = faces[face_a, side_a % k]
-    start_b = faces[face_b, side_b % k]
-    return face_a, face_b, start_a == start_b
+    flat = np.ascontiguousarray(faces).reshape(-1)  # side s of face f is flat[f * k + s]
+    return face_a, face_b, np.take(flat, side_a) == np.take(flat, side_b)
 
 
 def _labels(n: int, a: IntArray, b: IntArray) -> IntArray:
@@ -109,17 +108,18 @@ def orientation_flips(
     as_is, turned = label[0::2], label[1::2]
     # Every state of a piece is >= 2 * its lowest face, and 2 * lowest is one of them.
     lowest = np.minimum(as_is, turned) // 2
-    _, piece = np.unique(lowest, return_inverse=True)
-    piece = piece.astype(np.int64).reshape(-1)
-    n_pieces = int(piece.max()) + 1
+    # Pieces numbered by their lowest face (a rank by marks: no sort).
+    marked = np.zeros(m, dtype=np.bool_)
+    marked[lowest] = True
+    lowest_faces = np.flatnonzero(marked)
+    piece = (np.cumsum(marked) - 1)[lowest].astype(np.int64)
+    n_pieces = int(lowest_faces.shape[0])
     root_of_piece = np.full(n_pieces, m, dtype=np.int64)
     if roots is not None:
         preferred = np.asarray(roots, dtype=np.int64).reshape(-1)
         preferred = preferred[(preferred >= 0) & (preferred < m)]
         np.minimum.at(root_of_piece, piece[preferred], preferred)
-    root_of_piece = np.where(
-        root_of_piece < m, root_of_piece, lowest[np.unique(piece, return_index=True)[1]]
-    )
+    root_of_piece = np.where(root_of_piece < m, root_of_piece, lowest_faces)
     orientable = as_is != turned
     flip = orientable & (as_is != as_is[root_of_piece[piece]])
     conflicts = int(np.count_nonzero(same_way ^ flip[face_a] ^ flip[face_b]))

@@ -642,9 +642,11 @@ def find_defects(soup: Soup, split: PatchSplit | None, gap_tolerance: float) -> 
     n = soup.n_triangles
     columns = np.ascontiguousarray(soup.local(soup.vertices).T)
     stored = np.empty((3, 3, n + points.shape[0]))  # component-major: (corner, xyz, K)
-    for corner in range(3):
-        stored[corner, :, :n] = columns[:, soup.triangles[:, corner]]
-        stored[corner, :, n:] = columns[:, points]
+    for corner in range(3):  # 1-D gathers: numpy's fancy indexing of rows is slower
+        index = np.ascontiguousarray(soup.triangles[:, corner])
+        for axis in range(3):
+            np.take(columns[axis], index, out=stored[corner, axis, :n])
+            np.take(columns[axis], points, out=stored[corner, axis, n:])
     groups = np.concatenate(
         [soup.triangle_surface, np.full(points.shape[0], len(soup.surfaces), np.int64)]
     )
