@@ -15,6 +15,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.geometry.arrays import BoolArray, IntArray
+from geobrep.geometry.graph import component_roots
+from geobrep.geometry.mesh import compact_indices
 
 __all__ = ["TetFaces", "root_vertices"]
 
@@ -83,14 +85,9 @@ class TetFaces:
         a, b = self.order[shared], self.order[shared + 1]
         flat = barrier.reshape(-1)
         keep = ~(flat[a] | flat[b])
-        from scipy.sparse import coo_matrix  # imported here: reading a TSurf needs no scipy
-        from scipy.sparse.csgraph import connected_components
-
-        graph = coo_matrix(
-            (np.ones(int(keep.sum()), dtype=np.int8), (a[keep] // 4, b[keep] // 4)), shape=(n, n)
-        )
-        count, labels = connected_components(graph, directed=False)
-        return int(count), labels.astype(np.int64)
+        roots = component_roots(n, a[keep] // 4, b[keep] // 4)
+        used, labels = compact_indices(roots, n)
+        return int(used.shape[0]), labels
 
     def seed(self, xyz: NDArray[np.float64], key: IntArray, side: int) -> int | None:
         """The tetrahedron on the ``side`` (+1 / -1) of triangle ``key`` (3 vertex indices)

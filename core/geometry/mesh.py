@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike
 from geobrep.errors import DegenerateGeometryError, EntityValidationError
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.geometry.bbox import column_extremes
+from geobrep.geometry.graph import close_pairs, component_roots
 from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
 
 __all__ = [
@@ -495,38 +496,29 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
         labels = labels.reshape(-1)
     else:
         centre = 0.5 * np.add(*column_extremes(verts))
-        from scipy.sparse import coo_matrix  # imported here: keeps `import geobrep` fast
-        from scipy.sparse.csgraph import connected_components
-        from scipy.spatial import cKDTree
-
         local = verts - centre
         candidates = _merge_candidates(local, tol)
-        pairs = cKDTree(np.take(local, candidates, axis=0)).query_pairs(
-            r=tol, output_type="ndarray"
-        )
-        # Components over the vertices in a pair only (a few): the others stay alone.
-        linked, ends = compact_indices(np.take(candidates, pairs), n)
-        n_linked, linked_labels = 0, np.zeros(0, dtype=np.int64)
-        if linked.size:
-            graph = coo_matrix(
-                (np.ones(ends.shape[0], dtype=np.int8), (ends[:, 0], ends[:, 1])),
-                shape=(linked.shape[0], linked.shape[0]),
-            )
-            n_linked, linked_labels = connected_components(graph, directed=False)
-        alone = np.ones(n, dtype=np.bool_)
-        alone[linked] = False
-        labels = np.empty(n, dtype=np.int64)
-        labels[linked] = linked_labels
-        labels[alone] = n_linked + np.arange(n - linked.shape[0], dtype=np.int64)
-        n_groups = n_linked + n - linked.shape[0]
-        first = np.full(n_groups, n, dtype=np.int64)
-        np.minimum.at(first, labels, np.arange(n, dtype=np.int64))  # lowest index per group
+        pairs = np.take(candidates, _close_pairs(np.take(local, candidates, axis=0), tol))
+        roots = component_roots(n, pairs[:, 0], pairs[:, 1])
+        first, labels = compact_indices(roots, n)  # the lowest index of each group
     # first[g] is the lowest index of group g; renumber groups by that index.
     order = np.argsort(first)
     rank = np.empty(order.shape[0], dtype=np.int64)
     rank[order] = np.arange(order.shape[0], dtype=np.int64)
     representatives = first[order]
     return np.take(verts, representatives, axis=0), np.take(rank, labels)
+
+
+def _close_pairs(points: FloatArray, tol: float) -> IntArray:
+    """Pairs of ``points`` within ``tol``: a hashed grid, or scipy's k-d tree (imported only
+    then) for a crowd of points so close together that the grid would be quadratic."""
+    pairs = close_pairs(points, tol)
+    if pairs is not None:
+        return pairs
+    from scipy.spatial import cKDTree
+
+    found: IntArray = cKDTree(points).query_pairs(r=tol, output_type="ndarray")
+    return found.astype(np.int64).reshape(-1, 2)
 
 
 def part_vertices(faces: ArrayLike, labels: ArrayLike | None, n_vertices: int) -> list[IntArray]:
@@ -585,18 +577,9 @@ def merge_close_vertices_in_parts(
         joined = np.flatnonzero(first[inverse] != np.arange(members.shape[0]))
         rows.append(members[joined])
         cols.append(members[first[inverse[joined]]])
-    from scipy.sparse import coo_matrix  # imported here: keeps `import geobrep` fast
-    from scipy.sparse.csgraph import connected_components
-
     a, b = np.concatenate(rows), np.concatenate(cols)
-    graph = coo_matrix((np.ones(a.shape[0], dtype=np.int8), (a, b)), shape=(n, n))
-    n_groups, labels = connected_components(graph, directed=False)
-    first_index = np.empty(n_groups, dtype=np.int64)
-    first_index[labels[::-1]] = np.arange(n - 1, -1, -1, dtype=np.int64)  # the lowest wins
-    order = np.argsort(first_index)
-    rank = np.empty(n_groups, dtype=np.int64)
-    rank[order] = np.arange(n_groups, dtype=np.int64)
-    return verts[first_index[order]].copy(), rank[labels].astype(np.int64, copy=False)
+    first_index, labels = compact_indices(component_roots(n, a, b), n)
+    return verts[first_index].copy(), labels
 
 
 def sort_around_axis(origin: ArrayLike, axis: ArrayLike, directions: ArrayLike) -> IntArray:

@@ -4,7 +4,8 @@ Two faces sharing a *manifold* edge (one used by exactly two face sides) agree w
 along it in opposite directions. :func:`orientation_flips` finds, for every connected piece of
 the mesh (faces joined through manifold edges), the flips that make all its faces agree with
 one face of the piece (its *root*), in O(M log M): the two states of every face (as is,
-reversed) joined where neighbours agree, and scipy's connected components of those states.
+reversed) joined where neighbours agree, and the connected components of those states
+(:func:`geobrep.geometry.graph.component_roots`).
 Edges used by more than two faces do not join faces: the orientation is not decided there.
 
 >>> import numpy as np
@@ -21,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from geobrep.geometry.arrays import BoolArray, IntArray
+from geobrep.geometry.graph import component_roots
 from geobrep.geometry.mesh import _as_faces, _edge_table
 
 __all__ = ["OrientationFlips", "neighbour_pairs", "orientation_flips"]
@@ -64,17 +66,8 @@ def neighbour_pairs(
 
 
 def _labels(n: int, a: IntArray, b: IntArray) -> IntArray:
-    """The lowest node of each node's component, nodes ``0 … n-1`` joined by pairs (a, b):
-    scipy's connected components, each labelled by its lowest node (imported here: keeps
-    ``import geobrep`` fast)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    graph = coo_matrix((np.ones(a.shape[0], dtype=np.int8), (a, b)), shape=(n, n))
-    n_components, component = connected_components(graph, directed=False)
-    lowest = np.empty(n_components, dtype=np.int64)
-    lowest[component[::-1]] = np.arange(n - 1, -1, -1, dtype=np.int64)  # the lowest wins
-    return np.asarray(lowest[component], dtype=np.int64)
+    """The lowest node of each node's component, nodes ``0 … n-1`` joined by pairs (a, b)."""
+    return component_roots(n, a, b)
 
 
 def orientation_flips(

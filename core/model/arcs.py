@@ -27,7 +27,8 @@ writing all agree.
 
 The computation is vectorised: edge–triangle incidence, multiset signatures per arc edge (one
 ``np.unique`` over a padded table), corner tests per vertex, and one depth-first walk over the
-graph of arc edges continuing each other (scipy) that lists every chain in order.
+graph of arc edges continuing each other (list ranking, :func:`geobrep.geometry.graph.path_order`)
+that lists every chain in order.
 
 >>> import geobrep
 >>> scene = geobrep.datasets.faulted_layer_cake()
@@ -48,6 +49,7 @@ from geobrep.errors import DegenerateGeometryError, TopologyError
 from geobrep.geometry import mesh
 from geobrep.geometry.arrays import BoolArray, IntArray
 from geobrep.geometry.bbox import column_extremes
+from geobrep.geometry.graph import component_roots, nearest_within, path_order
 from geobrep.model.entities import Surface
 from geobrep.model.scene import Scene
 from geobrep.model.topology import Arc, Corner, Patch, Topology
@@ -218,12 +220,7 @@ def _empty_chains() -> ArcChains:
 
 def _edge_components(a: IntArray, b: IntArray, n: int) -> IntArray:
     """Chain label of each of ``n`` arc edges, ``a[i]`` and ``b[i]`` continuing each other."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    graph = coo_matrix((np.ones(a.shape[0], np.int8), (a, b)), shape=(n, n))
-    labels: IntArray = connected_components(graph, directed=False)[1].astype(np.int64)
-    return labels
+    return mesh.compact_indices(component_roots(n, a, b), n)[1]
 
 
 def _corner_closed_chains(
@@ -301,19 +298,11 @@ def _chain_heads(ends: IntArray, links: _Links) -> tuple[IntArray, IntArray]:
 
 
 def _walk_chains(links: _Links, heads: IntArray, n: int) -> IntArray:
-    """The ``n`` arc edges chain after chain, each chain in order from its head.
-
-    A depth-first walk from a virtual root tied to every head lists each chain in order.
-    """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import depth_first_order
-
-    root = n
-    rows = np.concatenate([links.a, np.full(heads.shape[0], root, dtype=np.int64)])
-    cols = np.concatenate([links.b, heads])
-    graph = coo_matrix((np.ones(rows.shape[0], np.int8), (rows, cols)), shape=(n + 1, n + 1))
-    walk = depth_first_order(graph.tocsr(), root, directed=False, return_predecessors=False)
-    ordered = np.asarray(walk[1:], dtype=np.int64)
+    """The ``n`` arc edges chain after chain, each chain in order from its head."""
+    try:
+        ordered = path_order(n, links.a, links.b, heads)
+    except TopologyError:  # pragma: no cover - through pairs form paths
+        ordered = np.zeros(0, dtype=np.int64)
     if ordered.shape[0] != n:  # pragma: no cover - every chain has a head
         raise TopologyError("arc reconstruction failed: a chain does not end at a corner")
     return ordered
@@ -545,6 +534,18 @@ def _around(
     return members
 
 
+def _nearest(points: NDArray[np.float64], queries: NDArray[np.float64], reach: float) -> IntArray:
+    """The nearest of ``points`` to each query within ``reach`` (queries without one left
+    out): a hashed grid, or scipy's k-d tree for a crowd of points closer than ``reach``."""
+    nearest = nearest_within(points, queries, reach)
+    if nearest is None:
+        from scipy.spatial import cKDTree
+
+        distance, found = cKDTree(points).query(queries)
+        nearest = np.where(distance <= reach, found, -1)
+    return np.asarray(nearest[nearest >= 0], dtype=np.int64)
+
+
 def corners_and_arcs(
     surfaces: Mapping[int, Surface],
     patches: Sequence[Patch],
@@ -585,12 +586,11 @@ def corners_and_arcs(
     if extra_corners is not None:
         wanted = np.asarray(extra_corners, dtype=np.float64).reshape(-1, 3)
         if wanted.shape[0]:
-            from scipy.spatial import cKDTree
-
             centre = 0.5 * np.add(*column_extremes(merged))
-            distance, nearest = cKDTree(merged - centre).query(wanted - centre)
             hints = np.zeros(n_vertices, dtype=np.bool_)
-            hints[nearest[distance <= max(tolerance, 0.0) * 1.0000001]] = True
+            hints[_nearest(merged - centre, wanted - centre, max(tolerance, 0.0) * 1.0000001)] = (
+                True
+            )
     chains = chain_arc_edges(
         edges, offsets, incident_patch, np.flatnonzero(~inner), n_vertices, merged, hints
     )
