@@ -21,7 +21,14 @@ from numpy.typing import ArrayLike
 from geobrep.errors import TopologyError
 from geobrep.geometry.arrays import FloatArray, IntArray
 
-__all__ = ["close_pairs", "component_roots", "nearest_within", "path_order"]
+__all__ = [
+    "cell_hash",
+    "close_pairs",
+    "component_roots",
+    "equal_rows",
+    "nearest_within",
+    "path_order",
+]
 
 _HASH = (
     np.uint64(0x9E3779B97F4A7C15),
@@ -66,13 +73,26 @@ def component_roots(n: int, a: ArrayLike, b: ArrayLike) -> IntArray:
     return parent
 
 
-def _cube_hash(cubes: IntArray) -> IntArray:
-    """A 64-bit hash of integer cube coordinates (N, 3), as int64 for sorting."""
+def cell_hash(cubes: IntArray) -> IntArray:
+    """A 64-bit hash of integer cell coordinates (N, 3), as int64 for sorting: equal cells,
+    equal hashes (unequal cells share one rarely, which callers must tolerate)."""
     with np.errstate(over="ignore"):
         u = cubes.astype(np.uint64)
         key = (u[:, 0] * _HASH[0]) ^ (u[:, 1] * _HASH[1]) ^ (u[:, 2] * _HASH[2])
     hashed: IntArray = key.view(np.int64)
     return hashed
+
+
+def _ranges(sorted_keys: IntArray, wanted: IntArray) -> tuple[IntArray, IntArray]:
+    """Where each wanted key's run starts and ends in ``sorted_keys``: the needles are sorted
+    first, which makes the binary searches walk the keys in order (several times faster than
+    random needles on large arrays)."""
+    order = np.argsort(wanted)
+    needles = wanted[order]
+    lo, hi = np.empty_like(order), np.empty_like(order)
+    lo[order] = np.searchsorted(sorted_keys, needles, side="left")
+    hi[order] = np.searchsorted(sorted_keys, needles, side="right")
+    return lo, hi
 
 
 def _offsets(half: bool) -> IntArray:
@@ -101,7 +121,7 @@ def _grid_candidates(
     if max(np.abs(cubes_p).max(initial=0.0), np.abs(cubes_q).max(initial=0.0)) > 2.0**62:
         return None
     cp, cq = cubes_p.astype(np.int64), cubes_q.astype(np.int64)
-    keys = _cube_hash(cp)
+    keys = cell_hash(cp)
     order = np.argsort(keys, kind="stable")
     sorted_keys = keys[order]
     limit = max(_PAIRS_FLOOR, _PAIRS_PER_POINT * (n + q.shape[0]))
@@ -109,9 +129,8 @@ def _grid_candidates(
     right: list[IntArray] = []
     total = 0
     for offset in _offsets(same):  # with ``same``, the cube itself first
-        wanted = _cube_hash(cq + offset)
-        lo = np.searchsorted(sorted_keys, wanted, side="left")
-        hi = np.searchsorted(sorted_keys, wanted, side="right")
+        wanted = cell_hash(cq + offset)
+        lo, hi = _ranges(sorted_keys, wanted)
         counts = hi - lo
         total += int(counts.sum())
         if total > limit:
@@ -152,6 +171,30 @@ def _exact_pairs(points: FloatArray) -> IntArray:
     lowest = first[inverse]
     later = np.flatnonzero(lowest != np.arange(points.shape[0]))
     return np.stack([lowest[later], later], axis=1).astype(np.int64)
+
+
+def equal_rows(points: FloatArray) -> IntArray:
+    """For each point (N, 3), the lowest index of a point with the same coordinates (``-0.0``
+    equal to ``0.0``) found by one sort of a hash of the coordinates: two equal points get the
+    same index, except in the rare case where an unequal point's hash equals theirs and sorts
+    between them (a caller that searches close pairs afterwards still joins them).
+
+    >>> equal_rows(np.array([[0.0, 0, 0], [1, 0, 0], [-0.0, 0, 0]])).tolist()
+    [0, 1, 0]
+    """
+    n = points.shape[0]
+    if n == 0:
+        return np.zeros(0, dtype=np.int64)
+    bits = np.ascontiguousarray(points + 0.0).view(np.int64)
+    keys = cell_hash(bits)
+    order = np.argsort(keys, kind="stable")  # equal points in index order
+    rows = bits[order]
+    same = np.zeros(n, dtype=np.bool_)
+    same[1:] = (keys[order][1:] == keys[order][:-1]) & (rows[1:] == rows[:-1]).all(axis=1)
+    run_start = np.maximum.accumulate(np.where(same, 0, np.arange(n, dtype=np.int64)))
+    first = np.empty(n, dtype=np.int64)
+    first[order] = order[run_start]
+    return first
 
 
 def close_pairs(points: ArrayLike, distance: float) -> IntArray | None:

@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike
 from geobrep.errors import DegenerateGeometryError, EntityValidationError
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.geometry.bbox import column_extremes
-from geobrep.geometry.graph import close_pairs, component_roots
+from geobrep.geometry.graph import cell_hash, close_pairs, component_roots, equal_rows
 from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
 
 __all__ = [
@@ -413,29 +413,27 @@ def is_consistently_oriented(faces: ArrayLike) -> bool:
 def _merge_candidates(local: FloatArray, tol: float) -> IntArray:
     """Vertices that may lie within ``tol`` of another one (a superset; pairs are checked after).
 
-    Vertices are binned in cubes of side about ``1000 · tol``: two vertices within ``tol`` of each
-    other share a cube or both lie within ``tol`` of a cube face, so only vertices in crowded
-    cubes or near a face need the exact k-d tree search — a small share of a mesh whose vertex
-    spacing exceeds the tolerance. Falls back to every vertex when the cubes cannot be keyed.
+    Vertices are binned in cubes of side about ``1000 · tol`` (a hash of the cube numbers, so
+    any extent works): two vertices within ``tol`` of each other share a cube or both lie
+    within ``tol`` of a cube face, so only vertices in crowded cubes or near a face need the
+    exact search — a small share of distinct vertices whose spacing exceeds the tolerance.
+    Falls back to every vertex when the cubes are too fine for the coordinates.
     """
     n = local.shape[0]
     everything = np.arange(n, dtype=np.int64)
     # An odd cube size and a shifted origin keep lattice-aligned vertices off the cube faces.
     cell = 1021.37 * tol
     reach = float(np.abs(local).max()) if n else 0.0
-    if cell <= 1e-9 * reach or reach / cell > 2.0**19:
+    if cell <= 1e-9 * reach or reach / cell > 2.0**60:
         return everything
     shifted = local + 0.3819 * cell
     scaled = np.floor(shifted / cell)
     offsets = shifted - scaled * cell
     margin = 2.0 * tol + 8.0 * np.finfo(np.float64).eps * reach
     near_face = ((offsets <= margin) | (offsets >= cell - margin)).any(axis=1)
-    cubes = scaled.astype(np.int64)
-    low, high = column_extremes(cubes)
-    cubes -= low
-    dims = high - low + 1
-    keys = (cubes[:, 0] * dims[1] + cubes[:, 1]) * dims[2] + cubes[:, 2]
-    sorted_keys, order = _stable_sort(keys)
+    keys = cell_hash(scaled.astype(np.int64))
+    order = np.argsort(keys)
+    sorted_keys = keys[order]
     same = sorted_keys[1:] == sorted_keys[:-1]
     crowded = np.zeros(n, dtype=np.bool_)
     crowded[order[1:][same]] = True
@@ -495,11 +493,17 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
         _, first, labels = np.unique(verts + 0.0, axis=0, return_index=True, return_inverse=True)
         labels = labels.reshape(-1)
     else:
+        # equal vertices first (one sort), then close pairs among the distinct ones
+        same = equal_rows(verts)
+        distinct = np.flatnonzero(same == np.arange(n))
         centre = 0.5 * np.add(*column_extremes(verts))
-        local = verts - centre
+        local = np.take(verts, distinct, axis=0) - centre
         candidates = _merge_candidates(local, tol)
-        pairs = np.take(candidates, _close_pairs(np.take(local, candidates, axis=0), tol))
-        roots = component_roots(n, pairs[:, 0], pairs[:, 1])
+        found = _close_pairs(np.take(local, candidates, axis=0), tol)
+        pairs = np.take(distinct, np.take(candidates, found))
+        a = np.concatenate([np.arange(n, dtype=np.int64), pairs[:, 0]])
+        b = np.concatenate([same, pairs[:, 1]])
+        roots = component_roots(n, a, b)
         first, labels = compact_indices(roots, n)  # the lowest index of each group
     # first[g] is the lowest index of group g; renumber groups by that index.
     order = np.argsort(first)
