@@ -35,6 +35,11 @@ _LARGE_FACTOR = 2.0
 #: Grid cell size, in median extents, and the most cells along an axis.
 _CELL_FACTOR = 1.5
 _MAX_CELLS = 192
+#: A large triangle's cells are listed only in the blocks of this many cells per axis that
+#: another group comes near.
+_COARSE = 4
+#: Spread boxes reaching more cells than this many per box go through the blocks.
+_BLOCKS_OVER = 2
 #: Cell offsets (x, y, z) of the eight cells a box reaching two cells per axis may reach; code c
 #: has bit 4 set when the cell lies past the box's first cell along x, 2 along y, 1 along z.
 _OFFSETS = np.array([[(c >> 2) & 1, (c >> 1) & 1, c & 1] for c in range(8)], dtype=np.int64).T
@@ -66,6 +71,22 @@ class _Grid:
         self.strides = np.array([self.dims[1] * self.dims[2], self.dims[2], 1], dtype=np.int64)
         self.n_cells = int(np.prod(self.dims))
 
+    def coarser(self, factor: int) -> _Grid:
+        """The grid of ``factor``³ blocks of these cells (cell ``i`` lies in block ``i // factor``
+        along each axis), over the same origin."""
+        grid = object.__new__(_Grid)
+        grid.origin, grid.size = self.origin, self.size * factor
+        grid.dims = (self.dims - 1) // factor + 1
+        grid.strides = np.array([grid.dims[1] * grid.dims[2], grid.dims[2], 1], dtype=np.int64)
+        grid.n_cells = int(np.prod(grid.dims))
+        return grid
+
+    def index(self, key: IntArray) -> IntArray:
+        """Cell indices (xyz, R) of cell keys."""
+        return np.stack(
+            [key // self.strides[0], (key // self.strides[1]) % self.dims[1], key % self.dims[2]]
+        )
+
     def ranges(self, mins: FloatArray, maxs: FloatArray) -> tuple[IntArray, IntArray]:
         """First cell (xyz, K) of each box and how many cells past it the box reaches."""
         lo = np.floor((mins - self.origin) / self.size).astype(np.int64)
@@ -92,8 +113,7 @@ class _Grid:
         cell ``key``: no separating axis between it and the cell grown by ``margin`` among the
         triangle's normal and its edges crossed with x, y and z (the cell's own axes separate
         nothing: the triangle's box reaches the cell)."""
-        index = np.stack([key // self.strides[0], (key // self.strides[1]) % self.dims[1]])
-        index = np.concatenate([index, (key % self.dims[2])[None]])
+        index = self.index(key)
         half = 0.5 * self.size
         p = corners - (index * self.size + (self.origin + half))  # corners about the centre
         radius = (half + margin) * (1.0 + 1e-9)
@@ -118,27 +138,160 @@ class _Grid:
         return np.asarray(near)
 
 
+def _near_planes(
+    grid: _Grid, corners: FloatArray, which: IntArray, key: IntArray, margin: float
+) -> BoolArray:
+    """Whether the plane of triangle ``which[r]`` of ``corners`` (component-major, (corner,
+    xyz, W)) comes within ``margin`` of cell ``key[r]`` (a superset of the cells the triangle
+    comes near: the plane-normal axis of :meth:`_Grid.touches`, one normal per triangle)."""
+    one, two = corners[1] - corners[0], corners[2] - corners[0]
+    normal = np.stack(
+        [
+            one[1] * two[2] - one[2] * two[1],
+            one[2] * two[0] - one[0] * two[2],
+            one[0] * two[1] - one[1] * two[0],
+        ]
+    )
+    offset = (normal * corners[0]).sum(axis=0)
+    radius = (0.5 * grid.size + margin) * (1.0 + 1e-9)
+    reach = radius * np.abs(normal).sum(axis=0)
+    centre = grid.index(key) * grid.size + (grid.origin + 0.5 * grid.size)
+    height = np.take(normal[0], which) * centre[0] - np.take(offset, which)
+    height += np.take(normal[1], which) * centre[1]
+    height += np.take(normal[2], which) * centre[2]
+    return np.asarray(np.abs(height) <= np.take(reach, which))
+
+
+def _block_extremes(values: NDArray[Any], factor: int, lowest: bool) -> NDArray[Any]:
+    """Least (``lowest``) or greatest value of each block of ``factor`` ³ cells of a dense
+    (X, Y, Z) grid, flattened in block order."""
+    op = np.minimum if lowest else np.maximum
+    for axis in range(3):  # strided slices: elementwise passes, no reduction over short axes
+        moved = np.moveaxis(values, axis, 0)
+        out = moved[::factor].copy()
+        for k in range(1, factor):
+            part = moved[k::factor]
+            op(out[: part.shape[0]], part, out=out[: part.shape[0]])
+        values = np.moveaxis(out, 0, axis)
+    return np.ascontiguousarray(values).reshape(-1)
+
+
+def _spread_rows(
+    grid: _Grid,
+    boxes: tuple[IntArray, IntArray, IntArray],
+    around: tuple[NDArray[Any], NDArray[Any]],
+    large: BoolArray,
+    stored: FloatArray,
+    groups: NDArray[np.integer],
+    margin: float,
+) -> tuple[IntArray, IntArray, IntArray]:
+    """Rows (box, cell key, offset code) of the spread boxes ``boxes`` = (indices, first
+    cells, cells past them). ``around`` is the least and greatest group whose boxes have
+    their first cell in the 3 x 3 x 3 cells around each cell (dense grids). A large triangle
+    has rows only in the blocks of :data:`_COARSE` ³ cells its plane comes near where another
+    group is around, or where the plane of a large triangle of another group comes near too.
+
+    A large triangle spans many cells, most of them far from any other surface: the blocks
+    tell where its cells can matter before they are listed. A cell matters to it only where
+    a box of another group has its first cell around (they may pair or make each other near)
+    or where a large triangle of another group comes near it too.
+    Offset codes of large triangles are 0 (their pairs are deduplicated instead)."""
+    spread, first, past = boxes
+    big = large[spread]
+    box, key, code = grid.cells(first[:, ~big], past[:, ~big])
+    box = spread[~big][box]
+    wide = spread[big]
+    if wide.size == 0:
+        return box, key, code
+    coarse = grid.coarser(_COARSE)
+    shift = _COARSE.bit_length() - 1
+    low = first[:, big] >> shift
+    c_box, c_key, _ = coarse.cells(low, ((first[:, big] + past[:, big]) >> shift) - low)
+    position = np.searchsorted(wide, wide[c_box])
+    c_box = wide[c_box]
+    near = _near_planes(coarse, stored[:, :, wide], position, c_key, margin)
+    c_box, c_key = c_box[near], c_key[near]
+    group = groups[c_box]
+    lowest = _block_extremes(around[0], _COARSE, lowest=True)
+    highest = _block_extremes(around[1], _COARSE, lowest=False)
+    wanted = (lowest[c_key] < group) | (highest[c_key] > group)
+    planes_low = np.full(coarse.n_cells, np.iinfo(groups.dtype).max, dtype=groups.dtype)
+    planes_high = np.zeros(coarse.n_cells, dtype=groups.dtype)
+    np.minimum.at(planes_low, c_key, group)
+    np.maximum.at(planes_high, c_key, group)
+    wanted |= planes_low[c_key] < planes_high[c_key]
+    c_box, c_key = c_box[wanted], c_key[wanted]
+    # The cells of each wanted block inside the triangle's box.
+    start = coarse.index(c_key) << shift
+    position = np.searchsorted(spread, c_box)
+    box_first = first[:, position]
+    box_last = box_first + past[:, position]
+    sub_first = np.maximum(box_first, start)
+    sub_past = np.minimum(box_last, start + _COARSE - 1) - sub_first
+    f_row, f_key, _ = grid.cells(sub_first, sub_past)
+    return (
+        np.concatenate([box, c_box[f_row]]),
+        np.concatenate([key, f_key]),
+        np.concatenate([code, np.zeros(f_key.shape[0], dtype=np.int64)]),
+    )
+
+
 def _near_other_groups(
-    grid: _Grid, first: IntArray, past: IntArray, groups: NDArray[np.integer]
+    grid: _Grid,
+    first: IntArray,
+    past: IntArray,
+    groups: NDArray[np.integer],
+    large: tuple[BoolArray, FloatArray, float],
 ) -> tuple[BoolArray, IntArray, IntArray, IntArray, IntArray]:
     """Which boxes may meet a box of another group, and the rows of the spread boxes (those
-    reaching more than two cells along an axis): box, cell key, offset code.
+    reaching more than two cells along an axis): box, cell key, offset code (``large``: which
+    boxes are large triangles, the corners and the margin, for :func:`_spread_rows`).
 
     A box reaching at most two cells per axis is entered in its first cell only: a box it
     overlaps has entered a cell of the 3 x 3 x 3 around that one."""
     lower = grid.strides @ first
     spread = np.flatnonzero((past > 1).any(axis=0))
-    box, key, code = grid.cells(first[:, spread], past[:, spread])
-    box = spread[box]
-    lowest = np.full(grid.n_cells, np.iinfo(groups.dtype).max, dtype=groups.dtype)
-    highest = np.zeros(grid.n_cells, dtype=groups.dtype)
-    for where, group in ((lower, groups), (key, groups[box])):
-        np.minimum.at(lowest, where, group)
-        np.maximum.at(highest, where, group)
     dims = tuple(grid.dims.tolist())
-    mixed = (
-        _dilated(lowest.reshape(dims), np.minimum) < _dilated(highest.reshape(dims), np.maximum)
-    ).reshape(-1)
+    maximum = np.iinfo(groups.dtype).max
+    sizes = past[:, spread] + 1
+    if int((sizes[0] * sizes[1] * sizes[2]).sum()) <= _BLOCKS_OVER * first.shape[1]:
+        # Few spread rows: all of them at once, one dilation.
+        box, key, code = grid.cells(first[:, spread], past[:, spread])
+        box = spread[box]
+        lowest = np.full(grid.n_cells, maximum, dtype=groups.dtype)
+        highest = np.zeros(grid.n_cells, dtype=groups.dtype)
+        for where, group in ((lower, groups), (key, groups[box])):
+            np.minimum.at(lowest, where, group)
+            np.maximum.at(highest, where, group)
+        mixed = (
+            _dilated(lowest.reshape(dims), np.minimum) < _dilated(highest.reshape(dims), np.maximum)
+        ).reshape(-1)
+        near = mixed[lower]
+        near[spread] = False
+        near[box[mixed[key]]] = True
+        return near, spread, box, key, code
+    lowest = np.full(grid.n_cells, maximum, dtype=groups.dtype)
+    highest = np.zeros(grid.n_cells, dtype=groups.dtype)
+    np.minimum.at(lowest, lower, groups)
+    np.maximum.at(highest, lower, groups)
+    around = (
+        _dilated(lowest.reshape(dims), np.minimum),
+        _dilated(highest.reshape(dims), np.maximum),
+    )
+    is_large, stored, margin = large
+    box, key, code = _spread_rows(
+        grid, (spread, first[:, spread], past[:, spread]), around, is_large, stored, groups, margin
+    )
+    if box.size:
+        lowest = np.full(grid.n_cells, maximum, dtype=groups.dtype)
+        highest = np.zeros(grid.n_cells, dtype=groups.dtype)
+        np.minimum.at(lowest, key, groups[box])
+        np.maximum.at(highest, key, groups[box])
+        around = (
+            np.minimum(around[0], _dilated(lowest.reshape(dims), np.minimum)),
+            np.maximum(around[1], _dilated(highest.reshape(dims), np.maximum)),
+        )
+    mixed = (around[0] < around[1]).reshape(-1)
     near = mixed[lower]
     near[spread] = False
     near[box[mixed[key]]] = True
@@ -198,7 +351,10 @@ def stored_pairs(
     shifted = np.asarray(groups) - int(np.min(groups))
     table = shifted.astype(np.min_scalar_type(int(shifted.max())))
     first, past = grid.ranges(mins, maxs)
-    near, spread, s_box, s_key, s_code = _near_other_groups(grid, first, past, table)
+    large = extent > cell * (_LARGE_FACTOR / _CELL_FACTOR) + 2.0 * margin
+    near, spread, s_box, s_key, s_code = _near_other_groups(
+        grid, first, past, table, (large, stored, margin)
+    )
     # Rows of the boxes left: those reaching at most two cells per axis from the offsets table.
     is_spread = np.zeros(n, dtype=np.bool_)
     is_spread[spread] = True
@@ -224,7 +380,6 @@ def stored_pairs(
     live = lowest[key] < highest[key]
     box, key, code = box[live], key[live], code[live]
     # Large triangles: only the cells they come near; their pairs are deduplicated instead.
-    large = extent > cell * (_LARGE_FACTOR / _CELL_FACTOR) + 2.0 * margin
     rows = np.flatnonzero(large[box])
     if rows.size:
         touching = grid.touches(stored[:, :, box[rows]], key[rows], margin)

@@ -26,7 +26,7 @@ import numpy as np
 
 from geobrep.errors import TopologyError
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
-from geobrep.plugins.blocks._broad_phase import component_major, overlapping_pairs, stored_pairs
+from geobrep.plugins.blocks._broad_phase import overlapping_pairs, stored_pairs
 from geobrep.plugins.blocks._csr import concatenated_ranges
 from geobrep.plugins.blocks._patches import PatchSplit
 from geobrep.plugins.blocks._soup import Soup
@@ -418,8 +418,7 @@ def _crossings(
     their triangles are gathered then)."""
     local = soup.local(soup.vertices)
     if pairs is None:
-        stored = component_major(np.ascontiguousarray(local.T), soup.triangles)
-        i, j = stored_pairs(stored, soup.triangle_surface, margin=tol)
+        i, j = stored_pairs(soup.corners, soup.triangle_surface, margin=tol)
     else:
         i, j = _boxes_within(local, soup.triangles, *pairs, tol)
     if i.size == 0:

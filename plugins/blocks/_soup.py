@@ -10,6 +10,7 @@ counted. Quads are split along their 0-2 diagonal.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -18,6 +19,7 @@ from geobrep.errors import DegenerateGeometryError
 from geobrep.geometry import mesh
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.geometry.bbox import column_extremes
+from geobrep.plugins.blocks._broad_phase import component_major
 from geobrep.plugins.blocks.precision import Precision, data_tolerance, measure_precision
 
 __all__ = ["Soup", "build_soup"]
@@ -59,6 +61,12 @@ class Soup:
             triangle_surface=self.triangle_surface[keep],
             triangle_face=self.triangle_face[keep],
         )
+
+    @cached_property
+    def corners(self) -> FloatArray:
+        """Model-centred corners of the triangles, component-major: (corner, xyz, T) — gathered
+        once for the stages that need them (contact search, patch measures)."""
+        return component_major(np.ascontiguousarray(self.local(self.vertices).T), self.triangles)
 
     def surface_name(self, index: int) -> str:
         surface = self.surfaces[index]

@@ -1,0 +1,62 @@
+"""The broad phase lists a large triangle's cells only in blocks where another group may be:
+the same pairs as listing every cell of its box."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+import geobrep
+from geobrep.plugins.blocks import _broad_phase
+from geobrep.plugins.blocks._broad_phase import overlapping_pairs, stored_pairs
+from geobrep.plugins.blocks._soup import build_soup
+
+Pairs = set[tuple[int, int]]
+
+
+def both_ways(
+    monkeypatch: pytest.MonkeyPatch, run: Callable[[], tuple[np.ndarray, np.ndarray]]
+) -> tuple[Pairs, Pairs]:
+    found = []
+    for threshold in (10**9, 0):  # every cell of the boxes; through the blocks
+        monkeypatch.setattr(_broad_phase, "_BLOCKS_OVER", threshold)
+        i, j = run()
+        assert np.unique(i * (int(j.max(initial=0)) + 1) + j).size == i.size  # each pair once
+        found.append(set(zip(i.tolist(), j.tolist(), strict=True)))
+    return found[0], found[1]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_fans_and_small_triangles(monkeypatch: pytest.MonkeyPatch, seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    apex = np.array([0.0, 0.0, 10.0])
+    base = np.stack([np.linspace(-10.0, 10.0, 41), np.zeros(41), np.zeros(41)], axis=1)
+    fan = np.stack([np.repeat(apex[None], 40, axis=0), base[:-1], base[1:]], axis=1)
+    tilted = fan @ np.array([[1.0, 0.0, 0.0], [0.0, 0.8, 0.6], [0.0, -0.6, 0.8]]) + [0, 3, 0]
+    n = 600
+    centres = rng.uniform([-10.0, -2.0, 0.0], [10.0, 4.0, 10.0], size=(n, 1, 3))
+    small = centres + 0.3 * rng.normal(size=(n, 3, 3))
+    corners = np.concatenate([fan, tilted, small])
+    groups = np.concatenate([np.zeros(40), np.ones(40), rng.integers(2, 5, size=n)]).astype(int)
+    order = np.argsort(groups, kind="stable")
+    corners, groups = corners[order], groups[order]
+    for margin in (1e-3, 0.2):
+        direct, blocked = both_ways(
+            monkeypatch, lambda m=margin: overlapping_pairs(corners, groups, m)
+        )
+        assert direct == blocked
+        assert any(groups[a] == 0 and groups[b] == 1 for a, b in direct)  # the fans cross
+
+
+def test_layer_cake_walls(monkeypatch: pytest.MonkeyPatch) -> None:
+    # The south and north walls are fans of long triangles; horizons and the fault meet them.
+    model = geobrep.datasets.faulted_layer_cake(resolution=20.0)
+    soup = build_soup(model.surfaces, None, None)
+    for margin in (soup.tolerance, 1e-3 * soup.diagonal):
+        direct, blocked = both_ways(
+            monkeypatch, lambda m=margin: stored_pairs(soup.corners, soup.triangle_surface, m)
+        )
+        assert direct == blocked
+        assert len(direct) > 1000
