@@ -12,10 +12,16 @@ goes to negative z.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["angles", "arc_points", "minimum_curvature", "tangents"]
+__all__ = ["ARC_AGREEMENT", "StationPath", "angles", "arc_points", "minimum_curvature", "tangents"]
+
+#: Two stations are joined by the minimum-curvature arc of their angles when that arc ends this
+#: close to the second station, relative to the interval's measured depth.
+ARC_AGREEMENT = 1e-7
 
 
 def tangents(inclination: ArrayLike, azimuth: ArrayLike) -> NDArray[np.float64]:
@@ -95,3 +101,68 @@ def arc_points(
         straight[:, None], a, np.cos(phi)[:, None] * a + np.sin(phi)[:, None] * normal
     )
     return points, direction
+
+
+@dataclass(frozen=True)
+class StationPath:
+    """A path through stations as a function of measured depth.
+
+    Between two stations whose inclination and azimuth give the second from the first by the
+    minimum-curvature method (within :data:`ARC_AGREEMENT`), the path is that method's circular
+    arc; elsewhere (or without angles) the straight segment between them.
+
+    >>> md = np.array([0.0, 100.0])
+    >>> path = StationPath.of(md, minimum_curvature(md, [0, 90], [0, 90]), [0, 90], [0, 90])
+    >>> np.round(path.at(np.array([50.0]))[0], 6).tolist()  # half way round the quarter circle
+    [[18.646161, 0.0, -45.015816]]
+    """
+
+    md: NDArray[np.float64]
+    xyz: NDArray[np.float64]
+    direction: NDArray[np.float64] | None
+    arc: NDArray[np.bool_]
+
+    @classmethod
+    def of(
+        cls,
+        md: ArrayLike,
+        xyz: ArrayLike,
+        inclination: ArrayLike | None = None,
+        azimuth: ArrayLike | None = None,
+    ) -> StationPath:
+        depths = np.asarray(md, dtype=np.float64).reshape(-1)
+        points = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+        arc = np.zeros(max(depths.shape[0] - 1, 0), dtype=bool)
+        if inclination is None or azimuth is None or depths.shape[0] < 2:
+            return cls(depths, points, None, arc)
+        direction = tangents(inclination, azimuth)
+        steps = np.diff(minimum_curvature(depths, inclination, azimuth), axis=0)
+        error = np.linalg.norm(steps - np.diff(points, axis=0), axis=1)
+        arc = np.isfinite(error) & (error <= ARC_AGREEMENT * np.diff(depths))
+        return cls(depths, points, direction if arc.any() else None, arc)
+
+    def at(
+        self, md: ArrayLike
+    ) -> tuple[
+        NDArray[np.float64], NDArray[np.int64], NDArray[np.float64], NDArray[np.float64] | None
+    ]:
+        """Points at ``md`` (clamped to the stations' range), each depth's interval, the fraction
+        of it, and the path's direction there (None without arcs)."""
+        depths = np.asarray(md, dtype=np.float64).reshape(-1)
+        k = np.clip(np.searchsorted(self.md, depths, side="right") - 1, 0, max(len(self.md) - 2, 0))
+        if self.md.shape[0] < 2:
+            points = np.repeat(self.xyz[:1], depths.shape[0], axis=0)
+            return points, k.astype(np.int64), np.zeros_like(depths), None
+        span = self.md[k + 1] - self.md[k]
+        fraction = np.clip((depths - self.md[k]) / span, 0.0, 1.0)
+        start, end = self.xyz[k], self.xyz[k + 1]
+        points = start + fraction[:, None] * (end - start)
+        direction = None
+        if self.direction is not None:
+            bent, direction = arc_points(
+                start, self.direction[k], self.direction[k + 1], span, fraction
+            )
+            points = np.where(self.arc[k][:, None], bent, points)
+        points = np.where((fraction == 0.0)[:, None], start, points)
+        points = np.where((fraction == 1.0)[:, None], end, points)
+        return points, k.astype(np.int64), fraction, direction

@@ -32,18 +32,13 @@ import numpy as np
 from geobrep import PointSet, PolyLine, Property, Well, WellLog, WellZone
 from geobrep.geometry import Plane
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
-from geobrep.geometry.trajectory import angles, arc_points, minimum_curvature, tangents
+from geobrep.geometry.trajectory import StationPath, angles
 from geobrep.plugins import ClipContext, Keep, PropertyMap, halves, pack_halves
 from geobrep.plugins.clip._sides import interpolate_properties, vertex_sides
 from geobrep.plugins.clip.options import WellClipOptions, tolerance_of
 
 __all__ = ["Trajectory", "WellClipWarning", "clip_well", "section_well"]
 
-INCLINATION_NAMES = ("INCL", "INC", "inclination")
-AZIMUTH_NAMES = ("AZIM_GN", "AZIM", "AZIM_TN", "azimuth")
-#: A station pair follows a minimum-curvature arc when the arc's end is this close to the
-#: second station, relative to the interval's MD length.
-ARC_AGREEMENT = 1e-7
 _BISECTIONS = 64
 
 Interval = tuple[float, float]
@@ -55,52 +50,31 @@ class WellClipWarning(UserWarning):
 
 @dataclass(frozen=True)
 class Trajectory:
-    """A well's path as a function of MD: minimum-curvature arcs or straight segments."""
+    """A well's path as a function of MD (:attr:`geobrep.Well.path`), cut by planes."""
 
-    md: FloatArray
-    xyz: FloatArray
-    direction: FloatArray | None
-    arc: BoolArray
+    path: StationPath
     angle_names: tuple[str, str] | None
 
     @classmethod
     def of(cls, well: Well) -> Trajectory:
         """The path of ``well`` (arcs where its station angles give its stations)."""
-        md = np.asarray(well.md, dtype=np.float64)
-        xyz = np.asarray(well.vertices, dtype=np.float64)
-        names = _angle_names(well)
-        arc = np.zeros(max(md.shape[0] - 1, 0), dtype=bool)
-        if names is None or md.shape[0] < 2:
-            return cls(md, xyz, None, arc, None)
-        inc = np.asarray(well.point_data[names[0]].values, dtype=np.float64)
-        azi = np.asarray(well.point_data[names[1]].values, dtype=np.float64)
-        direction = tangents(inc, azi)
-        span = np.diff(md)
-        steps = np.diff(minimum_curvature(md, inc, azi), axis=0)
-        error = np.linalg.norm(steps - np.diff(xyz, axis=0), axis=1)
-        arc = np.isfinite(error) & (error <= ARC_AGREEMENT * span)
-        return cls(md, xyz, direction, arc, names)
+        return cls(well.path, well.angle_names)
+
+    @property
+    def md(self) -> FloatArray:
+        return self.path.md
+
+    @property
+    def xyz(self) -> FloatArray:
+        return self.path.xyz
+
+    @property
+    def arc(self) -> BoolArray:
+        return self.path.arc
 
     def at(self, md: FloatArray) -> tuple[FloatArray, IntArray, FloatArray, FloatArray | None]:
         """Positions at ``md``, with each depth's interval, fraction of it and path direction."""
-        depths = np.asarray(md, dtype=np.float64).reshape(-1)
-        last = max(self.md.shape[0] - 2, 0)
-        k = np.clip(np.searchsorted(self.md, depths, side="right") - 1, 0, last)
-        if self.md.shape[0] < 2:
-            return np.repeat(self.xyz[:1], depths.shape[0], 0), k, np.zeros_like(depths), None
-        span = self.md[k + 1] - self.md[k]
-        fraction = np.clip((depths - self.md[k]) / span, 0.0, 1.0)
-        start, end = self.xyz[k], self.xyz[k + 1]
-        points = start + fraction[:, None] * (end - start)
-        direction = None
-        if self.direction is not None:
-            bent, direction = arc_points(
-                start, self.direction[k], self.direction[k + 1], span, fraction
-            )
-            points = np.where(self.arc[k][:, None], bent, points)
-        points = np.where((fraction == 0.0)[:, None], start, points)
-        points = np.where((fraction == 1.0)[:, None], end, points)
-        return points, k, fraction, direction
+        return self.path.at(md)
 
     def crossings(self, plane: Plane, offset: float, tolerance: float) -> FloatArray:
         """MD of every strict crossing of the plane ``distance = offset`` between stations."""
@@ -137,16 +111,6 @@ class Trajectory:
             else:
                 intervals.append((a, b))
         return intervals
-
-
-def _angle_names(well: Well) -> tuple[str, str] | None:
-    inc = next((n for n in INCLINATION_NAMES if n in well.point_data), None)
-    azi = next((n for n in AZIMUTH_NAMES if n in well.point_data), None)
-    if inc is None or azi is None:
-        return None
-    if well.point_data[inc].values.ndim != 1 or well.point_data[azi].values.ndim != 1:
-        return None
-    return inc, azi
 
 
 def _intersect(first: list[Interval], second: list[Interval]) -> list[Interval]:

@@ -293,6 +293,24 @@ def _arc_md(depth_below_kickoff: float) -> float:
 
 
 class TestWell:
+    def test_positions_between_stations_follow_the_arc(self) -> None:
+        well = build_well()
+        md = np.array([215.0, 512.5, 1000.0])
+        phi = (md - 200.0) / RADIUS
+        horizontal = RADIUS * (1.0 - np.cos(phi))
+        azimuth = np.radians(60.0)
+        expected = well.head + np.stack(
+            [
+                horizontal * np.sin(azimuth),
+                horizontal * np.cos(azimuth),
+                -200.0 - RADIUS * np.sin(phi),
+            ],
+            axis=1,
+        )
+        np.testing.assert_allclose(well.position_at(md), expected, atol=1e-9)
+        straight = Well(head=well.head, vertices=well.vertices, md=well.md)  # no angles: chords
+        assert np.abs(straight.position_at(md) - expected).max() > 0.01
+
     def test_the_cut_is_at_the_md_of_the_minimum_curvature_arc(self) -> None:
         well = build_well()
         z = 50.0 - 200.0 - 300.0  # 300 m below the kickoff

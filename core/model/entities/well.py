@@ -4,7 +4,10 @@ A well's ``vertices`` are its trajectory stations (z up, in the scene's CRS) and
 measured depths along the hole, strictly increasing; the cells are the segments between
 consecutive stations. ``head`` is the well head (the point MD counts from) and ``datum`` names
 the depth reference (``"KB"``, ``"GL"``, ...) at ``datum_elevation``. Markers, zones and logs are
-placed by measured depth; :meth:`Well.position_at` turns MD into XYZ along the stations.
+placed by measured depth; :meth:`Well.position_at` turns MD into XYZ along the path: the
+minimum-curvature arc between stations whose inclination and azimuth (station properties
+``INCL`` and ``AZIM_GN``, ``AZIM`` or ``AZIM_TN``, in degrees) give them, else the straight
+segment.
 """
 
 from __future__ import annotations
@@ -16,12 +19,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from pydantic import Field, JsonValue, model_validator
 
+from geobrep.geometry.trajectory import StationPath
 from geobrep.model.arrays import FloatArray, NumericArray, Points, Vector3
 from geobrep.model.base import FrozenModel
 from geobrep.model.entities.base import VertexEntity
 from geobrep.model.properties import NoDataValue
 
-__all__ = ["Well", "WellLog", "WellMarker", "WellZone"]
+__all__ = ["AZIMUTH_NAMES", "INCLINATION_NAMES", "Well", "WellLog", "WellMarker", "WellZone"]
+
+#: Station properties taken as the inclination and the azimuth (grid north first), in degrees.
+INCLINATION_NAMES = ("INCL", "INC", "inclination")
+AZIMUTH_NAMES = ("AZIM_GN", "AZIM", "AZIM_TN", "azimuth")
 
 
 class WellMarker(FrozenModel):
@@ -106,15 +114,34 @@ class Well(VertexEntity):
         """Length of the station polyline."""
         return float(np.linalg.norm(np.diff(self.vertices, axis=0), axis=1).sum())
 
+    @property
+    def angle_names(self) -> tuple[str, str] | None:
+        """The station properties holding inclination and azimuth, or None."""
+        inc = next((n for n in INCLINATION_NAMES if n in self.point_data), None)
+        azi = next((n for n in AZIMUTH_NAMES if n in self.point_data), None)
+        if inc is None or azi is None:
+            return None
+        if self.point_data[inc].values.ndim != 1 or self.point_data[azi].values.ndim != 1:
+            return None
+        return inc, azi
+
+    @cached_property
+    def path(self) -> StationPath:
+        """The path through the stations: minimum-curvature arcs where the angles give them."""
+        names = self.angle_names
+        if names is None:
+            return StationPath.of(self.md, self.vertices)
+        inc, azi = (np.asarray(self.point_data[n].values, dtype=np.float64) for n in names)
+        return StationPath.of(self.md, self.vertices, inc, azi)
+
     def position_at(self, md: ArrayLike) -> NDArray[np.float64]:
-        """XYZ ``(n, 3)`` at measured depths ``md``, linear between stations (NaN outside)."""
+        """XYZ ``(n, 3)`` at measured depths ``md`` along :attr:`path` (NaN outside)."""
         depths = np.atleast_1d(np.asarray(md, dtype=np.float64))
         out = np.full((depths.shape[0], 3), np.nan)
         if self.n_stations == 0:
             return out
         inside = (depths >= self.md[0]) & (depths <= self.md[-1])
-        for axis in range(3):
-            out[inside, axis] = np.interp(depths[inside], self.md, self.vertices[:, axis])
+        out[inside] = self.path.at(depths[inside])[0]
         return out
 
     def marker_positions(self) -> NDArray[np.float64]:
