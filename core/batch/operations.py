@@ -112,8 +112,9 @@ def fit_points(scene: Scene, step: FitStep) -> Scene:
     from geobrep.ops.fitting import fit
 
     points = fit_inputs(scene, step.points)
+    options: dict[str, Any] = dict(step.options)
     surfaces: list[Entity] = [
-        fit(entity, method=step.method, **step.options).surface.model_copy(update={"id": None})
+        fit(entity, method=step.method, **options).surface.model_copy(update={"id": None})
         for entity in points
     ]
     if step.keep_input:

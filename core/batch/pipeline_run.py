@@ -443,7 +443,8 @@ def _fit(step: FitStep, scene: Scene, work: _Work) -> Applied:
     surfaces: list[Entity] = []
     notes: list[str] = []
     for entity in points:
-        result = fit(entity, method=step.method, **step.options)
+        options: dict[str, Any] = dict(step.options)
+        result = fit(entity, method=step.method, **options)
         label = entity.name or entity.label
         report = result.report
         if report is None:

@@ -462,13 +462,26 @@ def _as_entity(points: Any) -> Entity:
 
 
 def fit(
-    points: ArrayLike | PointSet | PolyLine, method: str = "hybrid", **options: Any
+    points: ArrayLike | PointSet | PolyLine,
+    method: str = "hybrid",
+    *,
+    markers: Any = None,
+    marker_surface: str | None = None,
+    marker_weight: float | str | None = None,
+    **options: Any,
 ) -> FitResult:
     """Fit a surface to points with a registered fitter.
 
     ``points`` is an ``(N, 3)`` array or a PointSet (skinning also takes a PolyLine whose parts are
     the sections). ``method`` is the fitter's name (``"skinning"``, ``"approximation"``,
     ``"kriging"``, ``"hybrid"`` or a plugin's); ``options`` are validated by its options model.
+
+    ``markers`` (a Well, wells, or a Scene's wells) adds the well markers that name
+    ``marker_surface`` (their ``surface``, or their name) to the points, placed on the wells'
+    paths at their MD; ``marker_weight`` weighs them in a least-squares fit (a number) or makes
+    them hard data the surface passes through (``"hard"``; kriging honours data exactly anyway).
+    The report then has the subset ``markers`` and each marker's misfit in
+    ``details["markers"]``.
 
     Raises:
         UnknownItemError: no fitter of that name (the message lists the registered ones).
@@ -484,6 +497,16 @@ def fit(
 
     entity = _as_entity(points)
     spec = registries().fitters.get(method)
+    found = None
+    if markers is not None:
+        from geobrep.ops._fit_markers import join_markers, picks
+
+        found = picks(markers, marker_surface)
+        assert isinstance(entity, PointSet | PolyLine)
+        first = int(entity.vertices.shape[0])
+        entity, options = join_markers(entity, found, marker_weight, spec, options)
+    elif marker_surface is not None or marker_weight is not None:
+        raise OptionsError("marker_surface and marker_weight need markers")
     kind = type(entity).__name__
     if spec.input_types and kind not in spec.input_types:
         raise OptionsError(f"{spec.label}: takes {', '.join(spec.input_types)}, not a {kind}")
@@ -495,6 +518,10 @@ def fit(
         known = result.distances
         if result.points is None and known is not None and known.shape[0] == vertices.shape[0]:
             result = dataclasses.replace(result, points=vertices)
+        if found is not None:
+            from geobrep.ops._fit_markers import marker_report
+
+            result = marker_report(result, found, first)
         return result
     if isinstance(result, NurbsSurface | Surface):
         return FitResult(surface=result, report=None, method=method, points=vertices)

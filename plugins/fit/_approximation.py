@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 import scipy.linalg as la
@@ -46,6 +46,7 @@ from geobrep.plugins.fit._frame import LocalFrame
 from geobrep.plugins.fit._knots import approximation_knots, merge_knots, uniform_knots
 from geobrep.plugins.fit._lsq import single_threaded_blas, solve_penalised
 from geobrep.plugins.fit._projection import invert_planar_map, project_points
+from geobrep.plugins.fit._split import point_roles
 from geobrep.plugins.fit.distance import surface_distances
 from geobrep.plugins.fit.options import ApproximationOptions
 from geobrep.plugins.fit.report import accuracy_report, sigma
@@ -82,6 +83,26 @@ class NetFit:
     @property
     def sigma(self) -> float:
         return sigma(self.residuals)
+
+
+@dataclass(frozen=True)
+class Roles:
+    """Per-point misfit weights and hard-data flags (None: every point weighs 1, none is hard)."""
+
+    weights: FloatArray | None = None
+    exact: NDArray[np.bool_] | None = None
+
+    def split(
+        self, u: FloatArray, v: FloatArray, values: FloatArray
+    ) -> tuple[dict[str, Any], tuple[FloatArray, FloatArray, FloatArray] | None]:
+        """``solve_net`` arguments: the least-squares points with their weights, and the hard
+        points as its ``exact`` argument."""
+        free = np.ones(u.shape[0], bool) if self.exact is None else ~self.exact
+        weights = None if self.weights is None else self.weights[free]
+        exact = None
+        if self.exact is not None and self.exact.any():
+            exact = (u[self.exact], v[self.exact], values[self.exact])
+        return {"u": u[free], "v": v[free], "values": values[free], "weights": weights}, exact
 
 
 def collect_points(entities: list[Entity], label: str) -> tuple[FloatArray, PointSet | None]:
@@ -140,17 +161,18 @@ def solve_net(
     fixed: NDArray[np.bool_] | None = None,
     fixed_values: FloatArray | None = None,
     exact: tuple[FloatArray, FloatArray, FloatArray] | None = None,
+    weights: FloatArray | None = None,
     label: str = "approximation",
 ) -> FloatArray:
     """Control values ``(nu, nv, k)`` minimising misfit + ``lam`` · bending energy.
 
     ``lengths`` scale the unit parameter square to physical lengths for the bending energy;
     ``fixed`` holds control points at ``fixed_values``; ``exact = (u, v, values)`` are points the
-    surface must pass through.
+    surface must pass through; ``weights`` weigh the misfit of each point.
     """
     (p, q), (ku, kv) = degrees, knots
     nu, nv = ku.shape[0] - p - 1, kv.shape[0] - q - 1
-    normal, rhs = normal_equations(p, q, ku, kv, u, v, values)
+    normal, rhs = normal_equations(p, q, ku, kv, u, v, values, weights)
     penalty = None
     if lam > 0:
         penalty = bending_matrix(
@@ -330,7 +352,11 @@ def _planar_net(
 
 
 def _plane_fit(
-    local: FloatArray, options: ApproximationOptions, extent: float, frame: LocalFrame
+    local: FloatArray,
+    options: ApproximationOptions,
+    extent: float,
+    frame: LocalFrame,
+    roles: Roles,
 ) -> NetFit:
     p, q = options.degree_u, options.degree_v
     constraints = _constraints(options, frame, extent)
@@ -369,16 +395,19 @@ def _plane_fit(
             u = np.clip((ab[:, 0] - a0) / width, 0.0, 1.0)
             v = np.clip((ab[:, 1] - b0) / height, 0.0, 1.0)
             fixed, fixed_h = None, None
+        least, exact = roles.split(u, v, local[:, 2])
         heights = solve_net(
             (p, q),
             (ku, kv),
-            u,
-            v,
-            local[:, 2],
+            least.pop("u"),
+            least.pop("v"),
+            least.pop("values"),
             lam=lam,
             lengths=(width, height),
             fixed=fixed,
             fixed_values=fixed_h,
+            exact=exact,
+            **least,
         )
         net = NurbsNet(p, q, ku, kv, np.concatenate([planar, heights], axis=2))
         if constraints:
@@ -409,7 +438,11 @@ def _surface_lengths(net: NurbsNet) -> tuple[float, float]:
 
 
 def _base_surface_fit(
-    local: FloatArray, options: ApproximationOptions, extent: float, frame: LocalFrame
+    local: FloatArray,
+    options: ApproximationOptions,
+    extent: float,
+    frame: LocalFrame,
+    roles: Roles,
 ) -> NetFit:
     base = options.base_surface
     assert base is not None
@@ -433,12 +466,15 @@ def _base_surface_fit(
         kv = _inner_knots(q, spans_v, along_v)
         nu, nv = ku.shape[0] - p - 1, kv.shape[0] - q - 1
         fixed, fixed_xyz = _boundary_rows(constraints, ku, kv, nu, nv, 3)
+        least, exact = roles.split(u, v, local)
         control = solve_net(
             (p, q),
             (ku, kv),
-            u,
-            v,
-            local,
+            least.pop("u"),
+            least.pop("v"),
+            least.pop("values"),
+            exact=exact,
+            **least,
             lam=lam,
             lengths=(width, height),
             fixed=fixed if constraints else None,
@@ -545,7 +581,10 @@ def _grid_fit(local: FloatArray, options: ApproximationOptions) -> NetFit:
 
 
 def approximate_points(
-    points: FloatArray, options: ApproximationOptions, frame: LocalFrame | None = None
+    points: FloatArray,
+    options: ApproximationOptions,
+    frame: LocalFrame | None = None,
+    roles: Roles | None = None,
 ) -> NetFit:
     """Fit a net to world points; the returned net is in ``frame``'s local coordinates.
 
@@ -566,9 +605,9 @@ def approximate_points(
     if options.grid_shape is not None:
         fitted = _grid_fit(local, options)
     elif options.parameterization == "base_surface":
-        fitted = _base_surface_fit(local, options, extent, frame)
+        fitted = _base_surface_fit(local, options, extent, frame, roles or Roles())
     else:
-        fitted = _plane_fit(local, options, extent, frame)
+        fitted = _plane_fit(local, options, extent, frame, roles or Roles())
     return fitted
 
 
@@ -605,7 +644,9 @@ def fit_approximation(entities: list[Entity], options: ApproximationOptions) -> 
     """The ``approximation`` fitter: least squares with smoothing and boundary constraints."""
     points, pointset = collect_points(entities, "fitter 'approximation'")
     frame = LocalFrame.from_points(points, "fitter 'approximation'")
-    fitted = approximate_points(points, options, frame)
+    weights, exact = point_roles(pointset, points.shape[0], options.weight_property,
+                                 options.exact_property, "fitter 'approximation'")  # fmt: skip
+    fitted = approximate_points(points, options, frame, Roles(weights, exact))
     kind = pointset.kind if pointset is not None else None
     surface = nurbs_from_local(fitted, frame, "approximation", kind)
     distances = surface_distances(surface, points, fitted.u, fitted.v)

@@ -46,7 +46,12 @@ from geobrep.plugins.fit._domain_map import (
 from geobrep.plugins.fit._frame import LocalFrame
 from geobrep.plugins.fit._projection import invert_planar_map
 from geobrep.plugins.fit._skinning import SkinnedNet, rows_from_lattice, skin_rows
-from geobrep.plugins.fit._split import core_by_density, core_by_property, inside_polygon
+from geobrep.plugins.fit._split import (
+    core_by_density,
+    core_by_property,
+    inside_polygon,
+    point_roles,
+)
 from geobrep.plugins.fit.distance import surface_distances
 from geobrep.plugins.fit.options import HybridOptions
 from geobrep.plugins.fit.report import accuracy_report, sigma
@@ -165,6 +170,7 @@ class _Data:
     skinned: FloatArray
     exact: FloatArray
     rim: FloatArray
+    rim_weights: FloatArray | None = None
 
 
 def _fit_level(
@@ -212,6 +218,7 @@ def _fit_level(
         fixed=core_fixed,
         fixed_values=core_heights,
         exact=(u_exact, v_exact, data.exact[:, 2]),
+        weights=data.rim_weights,
         label=LABEL,
     )
     net = in_plane.with_control_points(np.concatenate([planar, heights], axis=2))
@@ -310,8 +317,12 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
     """The ``hybrid`` fitter: skin the core, approximate the rim against it, report accuracy."""
     points, pointset = collect_points(entities, LABEL)
     frame = LocalFrame.from_points(points, LABEL)
-    core_mask = _checked_core_mask(points, frame, options, pointset)
-    core = _skinned_core(points, core_mask, frame, options)
+    weights, hard = point_roles(
+        pointset, points.shape[0], options.weight_property, options.exact_property, LABEL
+    )
+    hard = np.zeros(points.shape[0], bool) if hard is None else hard
+    core_mask = _checked_core_mask(points, frame, options, pointset, hard)
+    core = _skinned_core(points, core_mask, frame, options, (weights, hard))
     fitted, layout = _fit_rim(core, options, int((~core_mask).sum()))
     return _hybrid_result(points, pointset, core_mask, core, (fitted, layout), options)
 
@@ -330,11 +341,16 @@ class _Core:
 
 
 def _checked_core_mask(
-    points: FloatArray, frame: LocalFrame, options: HybridOptions, pointset: PointSet | None
+    points: FloatArray,
+    frame: LocalFrame,
+    options: HybridOptions,
+    pointset: PointSet | None,
+    hard: NDArray[np.bool_],
 ) -> NDArray[np.bool_]:
-    """The core points; a core too small to skin or an empty rim is an options error."""
+    """The core points (never hard data); a core too small to skin or an empty rim is an
+    options error."""
     p, q = options.degree_u, options.degree_v
-    core_mask = _core_mask(points, frame.to_local(points)[:, :2], options, pointset)
+    core_mask = _core_mask(points, frame.to_local(points)[:, :2], options, pointset) & ~hard
     n_core, n_rim = int(core_mask.sum()), int((~core_mask).sum())
     if n_core < (p + 1) * (q + 1):
         raise OptionsError(
@@ -347,9 +363,15 @@ def _checked_core_mask(
 
 
 def _skinned_core(
-    points: FloatArray, core_mask: NDArray[np.bool_], frame: LocalFrame, options: HybridOptions
+    points: FloatArray,
+    core_mask: NDArray[np.bool_],
+    frame: LocalFrame,
+    options: HybridOptions,
+    roles: tuple[FloatArray | None, NDArray[np.bool_]],
 ) -> _Core:
-    """Skin the longest run of regular rows of the core; the other core rows become exact."""
+    """Skin the longest run of regular rows of the core; the other core rows and the hard data
+    become exact."""
+    weights, hard = roles
     p, q = options.degree_u, options.degree_v
     core_index = np.flatnonzero(core_mask)
     rows, angle = rows_from_lattice(frame.to_local(points[core_index])[:, :2], LABEL)
@@ -359,12 +381,13 @@ def _skinned_core(
     skinned = skin_rows([local[core_index[r]] for r in rows[first:last]], p, q, LABEL)
     skinned_index = np.concatenate([core_index[r] for r in rows[first:last]])
     others = rows[:first] + rows[last:]
-    exact_index = (
-        np.concatenate([core_index[r] for r in others]) if others else np.zeros(0, np.int64)
+    exact_index = np.concatenate([*(core_index[r] for r in others), np.flatnonzero(hard)]).astype(
+        np.int64
     )
-    rim_index = np.flatnonzero(~core_mask)
+    rim_index = np.flatnonzero(~core_mask & ~hard)
     order = np.concatenate([skinned_index, exact_index, rim_index])
-    data = _Data(local[skinned_index], local[exact_index], local[rim_index])
+    rim_weights = None if weights is None else weights[rim_index]
+    data = _Data(local[skinned_index], local[exact_index], local[rim_index], rim_weights)
     return _Core(frame, local, skinned, data, order)
 
 

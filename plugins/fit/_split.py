@@ -13,8 +13,11 @@ point inside that region belongs to the core.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import NDArray
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
@@ -22,7 +25,13 @@ from geobrep import PointSet
 from geobrep.errors import DegenerateGeometryError, OptionsError
 from geobrep.geometry.arrays import BoolArray, FloatArray
 
-__all__ = ["core_by_density", "core_by_property", "inside_polygon", "otsu_threshold"]
+__all__ = [
+    "core_by_density",
+    "core_by_property",
+    "inside_polygon",
+    "otsu_threshold",
+    "point_roles",
+]
 
 
 def inside_polygon(xy: FloatArray, polygon: FloatArray) -> BoolArray:
@@ -56,6 +65,42 @@ def core_by_property(points: PointSet | None, name: str) -> BoolArray:
             f"fitter 'hybrid': option 'core_property': {name!r} is not a scalar property"
         )
     return np.asarray(values != 0)
+
+
+def point_roles(
+    points: PointSet | None, n_points: int, weight: str | None, exact: str | None, label: str
+) -> tuple[FloatArray | None, BoolArray | None]:
+    """Per-point weights and hard-data flags from the options ``weight_property`` and
+    ``exact_property`` (None where the option is not given)."""
+    weights = None
+    if weight is not None:
+        weights = _scalar(points, n_points, weight, "weight_property", label).astype(np.float64)
+        if not (np.isfinite(weights).all() and (weights >= 0).all()):
+            raise OptionsError(
+                f"{label}: option 'weight_property': {weight!r} holds a weight that is negative "
+                "or not finite"
+            )
+    flags = None
+    if exact is not None:
+        flags = _scalar(points, n_points, exact, "exact_property", label) != 0
+    return weights, flags
+
+
+def _scalar(
+    points: PointSet | None, n_points: int, name: str, option: str, label: str
+) -> NDArray[Any]:
+    if points is None or name not in points.point_data:
+        available = sorted(points.point_data) if points is not None else []
+        raise OptionsError(
+            f"{label}: option {option!r}: the points have no property {name!r} "
+            f"(they have: {', '.join(available) or 'none'})"
+        )
+    values = np.asarray(points.point_data[name].values)
+    if values.ndim != 1 or values.shape[0] != n_points:
+        raise OptionsError(
+            f"{label}: option {option!r}: {name!r} is not one number per point of the fit"
+        )
+    return values
 
 
 def otsu_threshold(values: FloatArray) -> float:

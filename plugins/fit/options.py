@@ -103,6 +103,15 @@ class _Degrees(_FitOptions):
     degree_v: int = Field(default=3, ge=1, le=7)
 
 
+class _PointRoles(_Degrees):
+    weight_property: str | None = None
+    """Point property of per-point weights (finite, ≥ 0) of the least-squares misfit: a point of
+    weight w counts as w points (default 1 each)."""
+    exact_property: str | None = None
+    """Point property flagging (non-zero) points the surface must pass through exactly: hard
+    data such as well markers."""
+
+
 class SkinningOptions(_Degrees):
     """Skinning: ``degree_u`` along the rows/sections, ``degree_v`` across them."""
 
@@ -110,7 +119,7 @@ class SkinningOptions(_Degrees):
     """Integer point property numbering the row of each point (rows found automatically if None)."""
 
 
-class ApproximationOptions(_Degrees):
+class ApproximationOptions(_PointRoles):
     """Least-squares approximation with bending-energy smoothing and boundary constraints."""
 
     control_points: tuple[int, int] | None = None
@@ -146,6 +155,8 @@ class ApproximationOptions(_Degrees):
                 raise ValueError("grid_shape needs at least 2 rows and 2 columns")
             if self.boundary_curves or self.parameterization != "plane":
                 raise ValueError("grid_shape takes neither boundary_curves nor a base_surface")
+            if self.weight_property is not None or self.exact_property is not None:
+                raise ValueError("grid_shape takes neither weight_property nor exact_property")
         if self.parameterization == "base_surface" and self.base_surface is None:
             raise ValueError("parameterization 'base_surface' needs the option base_surface")
         if self.parameterization == "plane" and self.base_surface is not None:
@@ -209,7 +220,7 @@ class KrigingOptions(_FitOptions):
         return self
 
 
-class HybridOptions(_Degrees):
+class HybridOptions(_PointRoles):
     """The hybrid workflow: skin the dense core, approximate the rim with the core as constraint."""
 
     core_property: str | None = None
