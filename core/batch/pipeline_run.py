@@ -19,6 +19,7 @@ so a failed input leaves no outputs behind.
 
 from __future__ import annotations
 
+import functools
 import time
 import warnings
 from collections import Counter
@@ -292,7 +293,7 @@ def run_steps(
         numbered.insert(0, (0, ReadStep()))
     work = _Work(source=source, targets=targets, registries=registries(), contain=contain)
     try:
-        branches: list[tuple[str, Scene]] = [("", Scene())]
+        branches: list[tuple[str, Scene]] = [("", _nothing_read())]
         for work.number, body in numbered:
             work.kind = body.kind
             begun = time.perf_counter()
@@ -333,6 +334,12 @@ def run_steps(
         seconds=time.perf_counter() - started,
     )
     return done, None
+
+
+@functools.cache
+def _nothing_read() -> Scene:
+    """The empty scene a pipeline starts from (scenes are immutable: one serves every file)."""
+    return Scene()
 
 
 def _write_outputs(work: _Work) -> dict[int, float]:
