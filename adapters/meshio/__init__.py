@@ -110,9 +110,13 @@ def _read_vtu(path: Path) -> Scene:
 
 
 def _write_vtu(scene: Scene, path: Path, options: VtuOptions) -> None:
+    from geobrep.adapters.meshio._vtu_writer import write_vtu
+
     layout = scene_to_layout(scene)
-    mesh = mesh_from_layout(layout, field_data=False)
-    write_mesh(mesh, path, "vtu", binary=True, compression=options.compression)
+    if len(layout.points) == 0:
+        write_mesh(mesh_from_layout(layout, field_data=False), path, "vtu")  # refuses it
+    # meshio's file, its arrays streamed in chunks (meshio's writer holds ~5x each array)
+    write_vtu(layout, path, options.compression)
     if layout.header is not None:
         embed_vtu_header(path, layout.header)
 
