@@ -24,7 +24,7 @@ from geobrep.errors import FormatError
 __all__ = ["BULK_KEYWORDS", "ORJSON", "Line", "Run", "Source", "parse_run", "scan", "split_tokens"]
 
 #: Keywords whose lines are parsed in bulk (the keyword, then numbers).
-BULK_KEYWORDS: tuple[str, ...] = ("VRTX", "PVRTX", "TRGL", "SEG", "TETRA", "ATOM")
+BULK_KEYWORDS: tuple[str, ...] = ("VRTX", "PVRTX", "TRGL", "SEG", "TETRA", "ATOM", "PATOM")
 
 
 @dataclass(frozen=True)
@@ -47,12 +47,18 @@ class Run:
 
 
 class Source:
-    """The file's bytes with line endings normalised to LF, and where each line starts."""
+    """The file's bytes and where each line starts and ends (without its line break).
+
+    LF and CRLF line breaks are kept as they are (a CR before an LF is no part of the line:
+    :attr:`ends` stops before it); a file with lone CRs (old Mac) has them turned into LFs.
+    """
 
     def __init__(self, path: Path, data: bytes) -> None:
         self.path = path
-        if b"\r" in data:
+        n_cr = data.count(b"\r")
+        if n_cr and n_cr != data.count(b"\r\n"):
             data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+            n_cr = 0
         self.data = data
         buffer = np.frombuffer(data, dtype=np.uint8)
         breaks = np.flatnonzero(buffer == 10)
@@ -60,6 +66,9 @@ class Source:
         self.ends = np.concatenate([breaks, [len(data)]]).astype(np.int64)
         if self.starts[-1] == len(data):  # a final newline does not start a line
             self.starts, self.ends = self.starts[:-1], self.ends[:-1]
+        if n_cr:  # CRLF: a line ends before its CR
+            before = np.take(buffer, np.maximum(self.ends - 1, 0))
+            self.ends -= (before == 13) & (self.ends > self.starts)
 
     @classmethod
     def read(cls, path: Path) -> Source:
@@ -167,6 +176,8 @@ def _renormalised(raw: bytes, keyword: bytes) -> bytes:
     as exporters on Windows leave them) costs one ``replace``.
     """
     body = raw.rstrip()
+    if b"\r" in body:
+        body = body.replace(b"\r", b" ")
     if b"\t" in body:
         body = body.replace(b"\t", b" ")
     while b"  " in body:
@@ -179,17 +190,20 @@ def _renormalised(raw: bytes, keyword: bytes) -> bytes:
 
 
 def _byte_map(kept: bytes, separators: bytes, separator: bytes) -> bytes:
-    """A ``bytes.translate`` table: ``kept`` bytes stay, ``separators`` become ``separator``
-    and every other byte ``!``, which no number parser accepts (odd content fails the parse)."""
+    """A ``bytes.translate`` table: ``kept`` bytes stay, ``separators`` become ``separator``,
+    a CR (of a CRLF line break) a blank, and every other byte ``!``, which no number parser
+    accepts (odd content fails the parse)."""
     table = bytearray(b"!" * 256)
     for byte in kept:
         table[byte] = byte
     for byte in separators:
         table[byte] = separator[0]
+    table[13] = 32
     return bytes(table)
 
 
-#: Float runs become one JSON list: number bytes stay; blanks and line breaks are commas.
+#: Float runs become one JSON list: number bytes stay; blanks and line breaks are commas
+#: (a blank ending a line stays a blank: JSON whitespace).
 _JSON_MAP = _byte_map(b"0123456789.+-eE", b" \t\n", b",")
 #: Integer runs stay blank-separated text for numpy (no sign but ``-``, no exponent).
 _INT_MAP = _byte_map(b"0123456789-", b" \t\n", b" ")
@@ -233,26 +247,39 @@ def parse_run(source: Source, run: Run, integer: bool) -> NDArray[Any]:
     )
     if integer and not only_integers:
         raise BulkParseError  # "1.0", "1e0": the line parser says why they are no ids
-    starts = source.starts[run.first - 1 : run.first - 1 + run.count] - run.start
+    rows = slice(run.first - 1, run.first - 1 + run.count)
+    starts = source.starts[rows] - run.start
+    # one blank ending a line (as many exporters leave) is no separator
+    ends = source.ends[rows] - run.start
+    view = np.frombuffer(data, dtype=np.uint8, count=run.end - run.start, offset=run.start)
+    trailing = ends[np.take(view, ends - 1) == 32] - 1
     with contextlib.suppress(BulkParseError):  # single blanks only: else renormalise, below
-        return _parse_block(data, run.start, run.end, starts, len(keyword), only_integers)
+        return _parse_block(data, run.start, run.end, starts, len(keyword), only_integers, trailing)
     raw = _renormalised(data[run.start : run.end], keyword)
     breaks = np.flatnonzero(np.frombuffer(raw, dtype=np.uint8) == 10)
     if breaks.shape[0] != run.count - 1:
         raise BulkParseError
     starts = np.concatenate([[0], breaks + 1])
-    return _parse_block(raw, 0, len(raw), starts, len(keyword), only_integers)
+    none = np.zeros(0, dtype=np.int64)
+    return _parse_block(raw, 0, len(raw), starts, len(keyword), only_integers, none)
 
 
 def _parse_block(
-    data: bytes, start: int, end: int, starts: NDArray[np.int64], skip: int, integers: bool
+    data: bytes,
+    start: int,
+    end: int,
+    starts: NDArray[np.int64],
+    skip: int,
+    integers: bool,
+    trailing: NDArray[np.int64],
 ) -> NDArray[Any]:
     """Lines ``data[start:end]`` beginning at the offsets ``starts`` from ``start``, each a
-    keyword of ``skip`` bytes, a blank and numbers separated by single blanks."""
+    keyword of ``skip`` bytes, a blank and numbers separated by single blanks; ``trailing``:
+    the offsets of the blanks ending lines (no separators)."""
     count = starts.shape[0]
     heads = starts[:, None] + np.arange(skip + 1)  # each keyword and the blank after it
     if integers:
-        return _parse_integers(data, start, end, heads, count)
+        return _parse_integers(data, start, end, heads, count, trailing)
     # One copy of the run with a byte free at each end for the brackets, translated into a
     # second, mutable one (bytes.translate is a plain table walk; numpy's take is slower).
     text = bytearray(end - start + 2)
@@ -260,6 +287,8 @@ def _parse_block(
     json = text.translate(_JSON_MAP)
     del text
     json[0], json[-1] = ord("["), ord("]")
+    if trailing.size:
+        np.frombuffer(json, dtype=np.uint8)[1 + trailing] = 32
     # Each keyword and its blank become a marker entry ("null", or "[]" after a 3-letter
     # keyword; nothing else can produce either) that tells where the lines start.
     marker: list[Any] | None = None if skip >= 4 else []
@@ -287,13 +316,20 @@ def _parse_block(
 
 
 def _parse_integers(
-    data: bytes, start: int, end: int, heads: NDArray[np.int64], count: int
+    data: bytes,
+    start: int,
+    end: int,
+    heads: NDArray[np.int64],
+    count: int,
+    trailing: NDArray[np.int64],
 ) -> NDArray[np.int64]:
     """A run of integers (numpy's integer parser is faster than JSON's objects)."""
     view = np.frombuffer(data, dtype=np.uint8, count=end - start, offset=start)
-    # A rectangle: as many blanks on every line, hence as many numbers once numpy (which
-    # would accept repeated ones) has read the right total.
-    blanks = np.flatnonzero(view == 32)
+    # A rectangle: as many blanks on every line (a blank ending one aside), hence as many
+    # numbers once numpy (which would accept repeated ones) has read the right total.
+    is_blank = view == 32
+    is_blank[trailing] = False
+    blanks = np.flatnonzero(is_blank)
     per_line = np.diff(np.searchsorted(blanks, heads[:, 0]), append=blanks.shape[0])
     width = int(per_line[0])
     if width == 0 or not (per_line == width).all():

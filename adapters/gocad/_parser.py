@@ -589,6 +589,8 @@ class _Parser:
     ) -> int:
         if run.keyword == "ATOM":
             return self._atom_run(obj, run, vertices, cells, part, solid)
+        if run.keyword == "PATOM":
+            return self._patom_run(obj, run, vertices, cells, part, solid)
         if run.keyword in ("VRTX", "PVRTX"):
             part = self._ensure_part(obj, part, vertices, run.first)
             width = 4 + (obj.point_header.n_values if run.keyword == "PVRTX" else 0)
@@ -667,6 +669,42 @@ class _Parser:
             self._check_absent(obj, vertices, run.count, run.keyword, run.first)
         vertices.add_atoms(
             np.ascontiguousarray(block[:, 0]), np.ascontiguousarray(block[:, 1]), run.first
+        )
+        return part
+
+    def _patom_run(
+        self,
+        obj: GocadObject,
+        run: Run,
+        vertices: VertexTable,
+        cells: CellTable | None,
+        part: int,
+        solid: _SolidDraft,
+    ) -> int:
+        """A run of ``PATOM <new id> <id> <values>`` lines in one bulk parse (line by line
+        when it holds anything else, or no property header gives the lines values)."""
+        part = self._ensure_part(obj, part, vertices, run.first)
+        n_values = obj.point_header.n_values
+        try:
+            if run.count < 2 or not n_values:
+                raise BulkParseError
+            block = parse_run(self.source, run, integer=False)
+            if block.shape[1] != 2 + n_values:
+                raise BulkParseError
+            ids = block[:, :2]
+            if ids.dtype != np.int64:
+                if (ids != np.floor(ids)).any() or (np.abs(ids) > 2**53).any():
+                    raise BulkParseError  # the line parser says why they are no ids
+                ids = ids.astype(np.int64)
+        except BulkParseError:
+            self._run_lines(obj, run, vertices, cells, part, solid)
+            return part
+        values = self._finite(obj, "point", np.asarray(block[:, 2:], dtype=np.float64), run.first)
+        vertices.add_atoms(
+            np.ascontiguousarray(ids[:, 0]),
+            np.ascontiguousarray(ids[:, 1]),
+            run.first,
+            np.ascontiguousarray(values),
         )
         return part
 

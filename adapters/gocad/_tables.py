@@ -88,18 +88,21 @@ class VertexTable:
             )
         )
 
-    def add_atoms(self, ids: IntArray, refs: IntArray, first_line: int) -> None:
+    def add_atoms(
+        self, ids: IntArray, refs: IntArray, first_line: int, values: FloatArray | None = None
+    ) -> None:
         """A bulk run of ATOM lines (new ids at the positions of earlier ones, values
-        inherited)."""
+        inherited) or of PATOM lines (``values``: their own)."""
         self._flush()
         n = ids.shape[0]
+        inherit = values is None and self.n_values
         self._chunks.append(
             (
                 ids,
                 np.full((n, 3), np.nan),
                 refs,
-                np.full((n, self.n_values), np.nan),
-                np.full(n, _INHERIT if self.n_values else 0, dtype=np.int8),
+                np.full((n, self.n_values), np.nan) if values is None else values,
+                np.full(n, _INHERIT if inherit else 0, dtype=np.int8),
                 np.arange(first_line, first_line + n, dtype=np.int64),
             )
         )
