@@ -106,9 +106,12 @@ def _key_base(faces: IntArray) -> int:
 
 def _undirected_keys(faces: IntArray) -> tuple[IntArray, int]:
     """One int64 key lo * base + hi per face side (flattened, row-major), and ``base``."""
-    start, end = _side_ends(faces)
+    start, end = _side_ends(faces)  # ``end`` is a new array (fancy indexing): reused below
     base = _key_base(faces)
-    keys = np.minimum(start, end) * base + np.maximum(start, end)
+    keys = np.minimum(start, end)
+    np.maximum(start, end, out=end)
+    keys *= base
+    keys += end  # in place: two (M, k) arrays at a time, not four
     return keys.ravel(), base
 
 
@@ -309,9 +312,17 @@ def signed_volume(vertices: ArrayLike, faces: ArrayLike) -> float:
         return 0.0
     columns = _columns(verts, 0.5 * np.add(*column_extremes(verts)))
     tris = f if f.shape[1] == 3 else triangulate(f)[0]  # only read: no copy of triangles
-    a = _gather(columns, tris[:, 0])
-    cross = _cross(_gather(columns, tris[:, 1]), _gather(columns, tris[:, 2]))
-    return float(np.einsum("ij,ij->", a, cross)) / 6.0
+    total = 0.0
+    for start in range(0, tris.shape[0], _VOLUME_CHUNK):  # corners gathered a chunk at a time
+        part = tris[start : start + _VOLUME_CHUNK]
+        a = _gather(columns, part[:, 0])
+        cross = _cross(_gather(columns, part[:, 1]), _gather(columns, part[:, 2]))
+        total += float(np.einsum("ij,ij->", a, cross))
+    return total / 6.0
+
+
+#: Triangles whose corners :func:`signed_volume` gathers at once (about 40 MB of temporaries).
+_VOLUME_CHUNK = 1 << 18
 
 
 # --------------------------------------------------------------------------- edges

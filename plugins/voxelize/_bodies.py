@@ -42,17 +42,22 @@ class OctreeCube:
     size: float
 
 
-def _closed_body(surface: Surface, label: int, name: str, source: str) -> Body:
-    triangles, _ = mesh.triangulate(surface.faces)
+def _closed_body(
+    surface: Surface, label: int, name: str, source: str, checked: bool = False
+) -> Body:
+    """``checked``: the surface is known closed (its triangles need no second look)."""
+    faces = surface.faces
+    # A triangle surface's faces are read-only: the body shares them, no copy is made.
+    triangles = faces if faces.shape[1] == 3 else mesh.triangulate(faces)[0]
     if triangles.shape[0] == 0:
         raise TopologyError(f"{surface.label} has no faces: nothing to voxelize")
-    if not mesh.is_closed(triangles):
+    if not checked and not mesh.is_closed(triangles):
         open_edges = mesh.boundary_edges(triangles).shape[0]
         raise TopologyError(
             f"{surface.label} is not closed ({open_edges} boundary edges, or edges shared by "
             "more than two faces): only closed bodies can be voxelized"
         )
-    return Body(label, name, surface.vertices, triangles.astype(np.int64), source)
+    return Body(label, name, surface.vertices, triangles.astype(np.int64, copy=False), source)
 
 
 def _body_of(scene: Scene, entity: Entity) -> Body:
@@ -86,7 +91,11 @@ def collect_bodies(scene: Scene, selection: tuple[str | int, ...] | None) -> lis
         raise TopologyError(
             f"scene {scene.name!r} has no blocks and no closed surface: nothing to voxelize"
         )
-    return [_body_of(scene, surface) for surface in closed]
+    return [
+        # triangles found closed above are not checked again (quads are: on their triangles)
+        _closed_body(s, int(s.id or 0), s.name or s.label, "surface", s.faces.shape[1] == 3)
+        for s in closed
+    ]
 
 
 def octree_cube(

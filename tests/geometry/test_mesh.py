@@ -449,3 +449,15 @@ def test_edge_kernels_on_a_million_triangles() -> None:
     assert edges.shape[0] == 3 * (n - 1) ** 2 + 2 * (n - 1)
     assert not is_closed(faces)
     assert is_consistently_oriented(faces)
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 1 << 18])
+def test_signed_volume_in_chunks_is_trimeshs(chunk: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    from geobrep.geometry import mesh
+
+    monkeypatch.setattr(mesh, "_VOLUME_CHUNK", chunk)  # the corners gathered a chunk at a time
+    sphere = trimesh.creation.icosphere(subdivisions=3, radius=250.0)
+    vertices = np.asarray(sphere.vertices) + np.array([4.5e5, 6.1e6, -1.2e3])  # UTM scale
+    faces = np.asarray(sphere.faces)
+    assert signed_volume(vertices, faces) == pytest.approx(sphere.volume, rel=1e-12)
+    assert signed_volume(vertices, faces[:, ::-1]) == pytest.approx(-sphere.volume, rel=1e-12)
