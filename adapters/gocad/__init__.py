@@ -62,7 +62,12 @@ _HELD = {
     ".vs": ("VSet", frozenset({"PointSet"})),
     ".so": ("TSolid", frozenset({"TetMesh"})),
     ".ml": ("Model3d", frozenset({"Surface", "Block"})),
-    ".gp": ("group", frozenset({"Surface", "PolyLine", "PointSet", "TetMesh"})),
+    ".gp": (
+        "group",
+        frozenset(
+            {"Surface", "PolyLine", "PointSet", "TetMesh", "RegularGrid", "StructuredGrid", "Well"}
+        ),
+    ),
     ".vo": ("Voxet", frozenset({"RegularGrid"})),
     ".sg": ("SGrid", frozenset({"StructuredGrid"})),
     ".wl": ("Well", frozenset({"Well"})),
@@ -103,32 +108,41 @@ def _looks_like_stack(head: bytes) -> bool:
 _STACK_CAPABILITIES = FormatCapabilities(entity_types=frozenset(), names=True)
 
 
+def _entity_grid_losses(entity: object) -> list[str]:
+    """What a Voxet, SGrid or Well object cannot hold of ``entity`` (its own type's object)."""
+    from geobrep.model.entities import RegularGrid, StructuredGrid, Well
+
+    lost: list[str] = []
+    if isinstance(entity, RegularGrid):
+        if entity.point_data and entity.cell_data:
+            lost.append(f"{entity.label}: cell data (a Voxet holds node values)")
+        elif entity.cell_data:
+            lost.append(f"{entity.label}: cells (cell data are written at the cell centres)")
+    elif isinstance(entity, StructuredGrid):
+        if entity.points is None:
+            lost.append(f"{entity.label}: a corner-point grid (an SGrid holds node points)")
+        elif entity.actnum is not None and not entity.actnum.all():
+            lost.append(f"{entity.label}: inactive cells (actnum)")
+    elif isinstance(entity, Well):
+        if any(m.surface for m in entity.markers):
+            lost.append(f"{entity.label}: the surfaces its markers hit")
+        if entity.point_data or entity.cell_data:
+            names = ", ".join([*entity.point_data, *entity.cell_data])
+            lost.append(f"{entity.label}: station and segment properties ({names})")
+    return lost
+
+
 def _grid_losses(scene: Scene, path: Path) -> list[str]:
-    """What a Voxet or Well file cannot hold of the one entity it keeps."""
+    """What a Voxet, SGrid or Well file cannot hold of the one entity it keeps, and a group
+    file of each grid and well it holds."""
     from geobrep.model.entities import RegularGrid, StructuredGrid, Well
 
     suffix = path.suffix.lower()
-    lost: list[str] = []
-    for entity in scene.entities:
-        if suffix == ".vo" and isinstance(entity, RegularGrid):
-            if entity.point_data and entity.cell_data:
-                lost.append(f"{entity.label}: cell data (a Voxet holds node values)")
-            elif entity.cell_data:
-                lost.append(f"{entity.label}: cells (cell data are written at the cell centres)")
-            break
-        if suffix == ".sg" and isinstance(entity, StructuredGrid):
-            if entity.points is None:
-                lost.append(f"{entity.label}: a corner-point grid (an SGrid holds node points)")
-            elif entity.actnum is not None and not entity.actnum.all():
-                lost.append(f"{entity.label}: inactive cells (actnum)")
-            break
-        if suffix == ".wl" and isinstance(entity, Well):
-            if any(m.surface for m in entity.markers):
-                lost.append(f"{entity.label}: the surfaces its markers hit")
-            if entity.point_data or entity.cell_data:
-                lost.append(f"{entity.label}: station and segment properties")
-            break
-    return lost
+    wanted = {".vo": RegularGrid, ".sg": StructuredGrid, ".wl": Well}.get(suffix)
+    if suffix == ".gp":
+        return [s for e in scene.entities for s in _entity_grid_losses(e)]
+    first = next((e for e in scene.entities if wanted and isinstance(e, wanted)), None)
+    return _entity_grid_losses(first) if first is not None else []
 
 
 def _losses(scene: Scene, path: Path) -> list[str]:
@@ -138,7 +152,9 @@ def _losses(scene: Scene, path: Path) -> list[str]:
     object_type, held = _HELD.get(path.suffix.lower(), ("", frozenset()))
     if not held:
         return []
-    grid_lost = _grid_losses(scene, path) if object_type in ("Voxet", "SGrid", "Well") else []
+    grid_lost = (
+        _grid_losses(scene, path) if object_type in ("Voxet", "SGrid", "Well", "group") else []
+    )
     dropped: dict[str, int] = {}
     for entity in scene.entities:
         if entity.type in held or entity.type not in _FAMILY:

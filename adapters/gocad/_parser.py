@@ -28,6 +28,7 @@ from geobrep.adapters.gocad._lexer import (
     Line,
     Run,
     Source,
+    decode,
     parse_run,
     scan,
     split_tokens,
@@ -59,6 +60,7 @@ from geobrep.adapters.gocad._tables import (
 )
 from geobrep.adapters.limits import human_bytes, read_budget
 from geobrep.errors import FormatError
+from geobrep.model.entities import Entity
 
 __all__ = ["GocadObject", "GocadWarning", "parse_source"]
 
@@ -74,6 +76,8 @@ KNOWN_TYPES = {
     "homogeneousgroup": "HomogeneousGroup",
 }
 GROUP_TYPES = ("HeterogeneousGroup", "HomogeneousGroup")
+#: Object types a group member may be that are read by their own line readers (side files).
+GRID_MEMBER_TYPES = {"voxet": "Voxet", "sgrid": "SGrid", "well": "Well"}
 FLAG_NAMES = {"CNXYZ": 1, "XYZ": 2}
 _CELL_PREFIX = {"TSurf": "TRGL_", "PLine": "SEG_", "TSolid": "TETRA_", "LightTSolid": "TETRA_"}
 _ABSENT_SHARE = 8
@@ -137,6 +141,7 @@ class GocadObject:
     member_type: str | None = None  # a group's TYPE line
     members: list[GocadObject] = field(default_factory=list)
     extra_lines: list[str] = field(default_factory=list)
+    grid: Entity | None = None  # a Voxet, SGrid or Well member, read by its own reader
 
     @property
     def name(self) -> str:
@@ -289,11 +294,14 @@ class _Parser:
             raise self.error("no GOCAD object with a known type in the file", None)
         return objects
 
-    def parse_object(self, start: Line) -> GocadObject | None:
+    def parse_object(self, start: Line, group: GocadObject | None = None) -> GocadObject | None:
         tokens = start.text.split()
         if len(tokens) < 2:
             raise self.error("'GOCAD' without an object type", start.number)
         kind = KNOWN_TYPES.get(tokens[1].lower())
+        grid_kind = GRID_MEMBER_TYPES.get(tokens[1].lower())
+        if grid_kind is not None and group is not None:
+            return self._grid_member(start, grid_kind, tokens, group)
         if kind is None:
             self.warn(f"skipping GOCAD {tokens[1]} object (no reader for this type)", start.number)
             name = self._skip_object()
@@ -311,23 +319,45 @@ class _Parser:
 
     def _skip_object(self) -> str | None:
         """Pass over an object of unknown type; its header ``name`` if it has one."""
+        return self._object_end(0)[0]
+
+    def _object_end(self, last: int) -> tuple[str | None, int]:
+        """Pass over an object up to its ``END``: its header ``name`` if it has one, and the
+        number of its last line (``last`` if it has no line after its ``GOCAD`` line)."""
         name = None
         while True:
             item = self.stream.peek()
             if item is None:
-                return name
+                return name, last
             if isinstance(item, Line):
                 keyword = _keyword(item.text)
                 if keyword == "GOCAD":
                     self.warn("object without END before the next 'GOCAD' line", item.number)
-                    return name
+                    return name, last
                 self.stream.take()
+                last = item.number
                 if keyword == "END":
-                    return name
+                    return name, last
                 if name is None and item.text.lstrip().lower().startswith("name:"):
                     name = item.text.split(":", 1)[1].strip() or None
             else:
                 self.stream.take()
+                last = item.first + item.count - 1
+
+    def _grid_member(
+        self, start: Line, kind: str, tokens: list[str], group: GocadObject
+    ) -> GocadObject:
+        """A Voxet, SGrid or Well inside a group, read by its own reader from its lines (with
+        the lines before it blank, so that errors give the group file's line numbers); its side
+        files are found beside the group file."""
+        from geobrep.adapters.gocad._grid_members import read_member
+
+        _, last = self._object_end(start.number)
+        data = self.source.data[self.source.starts[start.number - 1] : self.source.ends[last - 1]]
+        text = "\n" * (start.number - 1) + decode(data)
+        obj = GocadObject(kind, tokens[2] if len(tokens) > 2 else "1", start.number)
+        obj.grid, obj.crs = read_member(self.source.path, text, kind, group.crs)
+        return obj
 
     # -- shared header parts --------------------------------------------------------------------
     def _header_block(self, obj: GocadObject, line: Line) -> None:
@@ -1086,7 +1116,7 @@ class _Parser:
                 if not in_members:
                     self.warn("group member outside BEGIN_MEMBERS", item.number)
                 self.stream.take()
-                member = self.parse_object(item)
+                member = self.parse_object(item, obj)
                 if member is not None:
                     obj.members.append(member)
                 continue

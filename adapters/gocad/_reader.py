@@ -252,6 +252,9 @@ class _Builder:
         if obj.type == "Model3d":
             models.append(obj)
             return None
+        if obj.grid is not None:  # a Voxet, SGrid or Well member, read by its own reader
+            self.entities.append(obj.grid.replace(id=self.next_id()))
+            return None
         try:
             self._add_entity(obj)
         except EntityValidationError as exc:

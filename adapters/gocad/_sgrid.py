@@ -256,11 +256,16 @@ def _values(
     return points, values
 
 
-def read_sgrid(path: Path) -> tuple[StructuredGrid, KeyedFile]:
-    """The grid of a .sg file with its properties; and the parsed header."""
-    keyed, _ = parse_keyed(path, read_text(path, "SGrid header"))
+def read_sgrid(
+    path: Path, text: str | None = None, inherited: dict[str, Any] | None = None
+) -> tuple[StructuredGrid, KeyedFile]:
+    """The grid of a .sg file with its properties; and the parsed header (``text`` and
+    ``inherited``: a group member's text and the group's CRS block, as for a Voxet)."""
+    if text is None:
+        text = read_text(path, "SGrid header")
+    keyed, _ = parse_keyed(path, text)
     layout = _layout(keyed)
-    z_sign = -1.0 if (keyed.crs or {}).get("ZPOSITIVE") == "Depth" else 1.0
+    z_sign = -1.0 if (keyed.crs or inherited or {}).get("ZPOSITIVE") == "Depth" else 1.0
     props = [p for _, p in sorted(property_lines(keyed).items())]
     if layout.splits:
         report(f"{path.name}: {layout.splits} SPLIT nodes are not read (the grid is unsplit)")

@@ -168,7 +168,11 @@ def side_file(path: Path, name: str, what: str) -> Path:
     folder = path.parent.resolve()
     side = (folder / name).resolve()
     if not name or not side.is_relative_to(folder):
-        raise FormatError(f"{what} {name!r} is not a file beside the header", path)
+        raise FormatError(
+            f"{what} {name!r} is not a file beside the header (side files outside the "
+            f"folder of {path.name}, absolute or through '..', are not read)",
+            path,
+        )
     return path.parent / name
 
 
@@ -240,12 +244,19 @@ def _ascii_table(
     return out
 
 
-def read_voxet(path: Path) -> tuple[RegularGrid, KeyedFile]:
-    """The grid of a .vo file with its properties as point data; and the parsed header."""
-    text = read_text(path, "Voxet header")
+def read_voxet(
+    path: Path, text: str | None = None, inherited: dict[str, Any] | None = None
+) -> tuple[RegularGrid, KeyedFile]:
+    """The grid of a .vo file with its properties as point data; and the parsed header.
+
+    ``text`` is the object's text when it is a member of a group file ``path`` (side files are
+    found beside ``path`` all the same); ``inherited`` the group's CRS block, which a member
+    without its own takes (``ZPOSITIVE``)."""
+    if text is None:
+        text = read_text(path, "Voxet header")
     keyed, _ = parse_keyed(path, text)
     axes = _axes(keyed)
-    z_sign = -1.0 if (keyed.crs or {}).get("ZPOSITIVE") == "Depth" else 1.0
+    z_sign = -1.0 if (keyed.crs or inherited or {}).get("ZPOSITIVE") == "Depth" else 1.0
     grid = voxet_grid(axes, z_sign, path, keyed.name)
     props = property_lines(keyed)
     counts = axes.counts or (1, 1, 1)

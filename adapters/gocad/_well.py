@@ -127,11 +127,15 @@ def _stations(builder: _WellBuilder, path: Path) -> tuple[np.ndarray, np.ndarray
     return head, head[None, :], np.zeros(1)
 
 
-def read_well(path: Path) -> tuple[Well, dict[str, Any] | None]:
-    """The well of a .wl file, and its CRS block."""
-    text = read_text(path, "Well file")
+def read_well(
+    path: Path, text: str | None = None, inherited: dict[str, Any] | None = None
+) -> tuple[Well, dict[str, Any] | None]:
+    """The well of a .wl file, and its CRS block (``text`` and ``inherited``: a group
+    member's text and the group's CRS block, as for a Voxet)."""
+    if text is None:
+        text = read_text(path, "Well file")
     keyed, _ = parse_keyed(path, text)
-    z_sign = -1.0 if (keyed.crs or {}).get("ZPOSITIVE") == "Depth" else 1.0
+    z_sign = -1.0 if (keyed.crs or inherited or {}).get("ZPOSITIVE") == "Depth" else 1.0
     builder = _WellBuilder(z_sign)
     for line in keyed.lines:
         builder.line(line)

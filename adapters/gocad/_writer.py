@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.adapters.gocad._grid_members import MemberFiles
 from geobrep.adapters.gocad._headers import quote_rest
 from geobrep.adapters.gocad._numbers import format_float, format_rows, row_pieces
 from geobrep.adapters.gocad._objects import (
@@ -67,6 +68,7 @@ class _Writer:
     def __init__(self, scene: Scene, path: Path) -> None:
         self.scene = scene
         self.path = path
+        self.members = MemberFiles(path)
 
     # -- shared head ------------------------------------------------------------------------
     def head(
@@ -505,7 +507,7 @@ class _Writer:
             return self.vset(entity)
         if isinstance(entity, TetMesh):
             return self.tsolid(entity)
-        return None
+        return self.members.text(entity, self.scene.crs)  # a grid or a well: a group member
 
     def group(self, group: Group, written: set[int]) -> bytes:
         out = ObjectText()

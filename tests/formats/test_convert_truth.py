@@ -36,7 +36,7 @@ GOCAD_TARGETS = {
     ".vs": {"PointSet"},
     ".so": {"TetMesh"},
     ".ml": {"Surface"},
-    ".gp": {"Surface", "PolyLine", "PointSet", "TetMesh"},
+    ".gp": {"Surface", "PolyLine", "PointSet", "TetMesh", "RegularGrid", "StructuredGrid", "Well"},
 }
 
 #: Files with this many vertices or more go to a subset of the formats (the whole test < 60 s).
@@ -235,26 +235,37 @@ def test_a_header_only_fault_is_kept_where_the_format_holds_it(tmp_path: Path) -
         assert [(s.name, s.n_points) for s in back.surfaces] == [("F3_fault", 0), ("H1_top", 4)]
 
 
-def test_a_voxet_the_reader_skips_is_reported_lost(tmp_path: Path) -> None:
-    with pytest.warns(UserWarning, match="Voxet"):
-        scene = read(GOCAD / "voxet_and_tsurf.gp")
+def _unreadable_member(folder: Path) -> Path:
+    """voxet_and_tsurf.gp with its Voxet made a GSurf, an object type geobrep has no reader for."""
+    path = folder / "gsurf_and_tsurf.gp"
+    text = (GOCAD / "voxet_and_tsurf.gp").read_text()
+    path.write_text(text.replace("GOCAD Voxet 1", "GOCAD GSurf 1"))
+    return path
+
+
+def test_an_object_the_reader_skips_is_reported_lost(tmp_path: Path) -> None:
+    source = _unreadable_member(tmp_path)
+    with pytest.warns(UserWarning, match="GSurf"):
+        scene = read(source)
     assert scene.metadata["skipped_on_read"] == [
-        "GOCAD Voxet 'porosity_grid' (line 6): no reader for this type"
+        "GOCAD GSurf 'porosity_grid' (line 6): no reader for this type"
     ]
     for name in ("g.vtu", "g.geobrep"):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            report = convert(GOCAD / "voxet_and_tsurf.gp", tmp_path / name).reports[0]
+            report = convert(source, tmp_path / name).reports[0]
         assert report.lost[0] == (
-            "skipped on read: GOCAD Voxet 'porosity_grid' (line 6): no reader for this type"
+            "skipped on read: GOCAD GSurf 'porosity_grid' (line 6): no reader for this type"
         )
         back = read(tmp_path / name)
         assert [s.name for s in back.surfaces] == ["top"]
         assert "skipped_on_read" not in back.metadata  # it described the source, not this file
 
 
-def test_a_group_of_voxets_only_is_an_error_not_an_unreadable_file(tmp_path: Path) -> None:
-    text = (GOCAD / "voxet_and_tsurf.gp").read_text()
+def test_a_group_of_unreadable_objects_only_is_an_error_not_an_unreadable_file(
+    tmp_path: Path,
+) -> None:
+    text = _unreadable_member(tmp_path).read_text()
     only = tmp_path / "grids.gp"
     only.write_text(text[: text.index("GOCAD TSurf")] + text[text.index("END_MEMBERS") :])
     for name in ("grids.vtu", "grids.vtk", "grids.msh"):
@@ -297,7 +308,7 @@ def test_a_pipeline_reports_what_its_reader_skipped_and_its_target_drops(tmp_pat
 
     pipeline = {
         "version": 1,
-        "inputs": [str(GOCAD / "voxet_and_tsurf.gp"), str(GOCAD / "split_cube.ml")],
+        "inputs": [str(_unreadable_member(tmp_path)), str(GOCAD / "split_cube.ml")],
         "output": str(tmp_path),
         "steps": [{"read": {}}, {"write": {"format": "gocad", "name": "{stem}.ts"}}],
     }
@@ -306,7 +317,7 @@ def test_a_pipeline_reports_what_its_reader_skipped_and_its_target_drops(tmp_pat
         summary = run_pipeline(pipeline)
     assert summary.ok, summary
     voxet, cube = (report.lost for report in summary.reports)
-    assert "skipped on read: GOCAD Voxet 'porosity_grid'" in " ".join(voxet)
+    assert "skipped on read: GOCAD GSurf 'porosity_grid'" in " ".join(voxet)
     assert any("3 Block entities dropped (a GOCAD TSurf file" in s for s in cube), cube
 
 

@@ -1,6 +1,7 @@
 """Mutated grid and well files (generated: a rotated Voxet with a big-endian float property and
 no-data values, a curvilinear SGrid with point, cell and flag files, a deviated well with
-markers, a faulted corner-point grid, a deviation table)
+markers, a faulted corner-point grid, a deviation table, LAS logs, a GOCAD group holding a
+Voxet, an SGrid, a Well and a point set)
 read as a scene or fail with the reader's own FormatError, never another exception or
 ``geobrep.read``'s catch-all ("<format> reader failed: ...")."""
 
@@ -17,6 +18,7 @@ from test_formats_grdecl import faulted_grid
 
 import geobrep
 from geobrep import (
+    PointSet,
     Property,
     RegularGrid,
     Scene,
@@ -90,6 +92,8 @@ def _files(folder: Path) -> dict[str, list[Path]]:
         dev = geobrep.write(_well().replace(markers=(), zones=()), folder / "w.dev")
         sg = geobrep.write(_sgrid(), folder / "s.sg")
         las = geobrep.write(_well().replace(logs=_logs()), folder / "w.las")
+        members = [_rotated_voxet(), _sgrid(), _well(), PointSet(vertices=[[0.0, 1.0, 2.0]])]
+        gp = geobrep.write(Scene(entities=members), folder / "m.gp")
     sides = sorted(folder.glob("s__*@@"))
     return {
         "v.vo": [vo, folder / "v__p@@"],
@@ -98,6 +102,7 @@ def _files(folder: Path) -> dict[str, list[Path]]:
         "g.grdecl": [grdecl],
         "w.dev": [dev],
         "w.las": [las],
+        "m.gp": [gp, *sorted(folder.glob("m_*@@"))],
     }
 
 
@@ -152,7 +157,7 @@ def _read_or_error(path: Path) -> geobrep.FormatError | None:
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
 @given(
-    st.sampled_from(["v.vo", "s.sg", "w.wl", "g.grdecl", "w.dev", "w.las"]),
+    st.sampled_from(["v.vo", "s.sg", "w.wl", "g.grdecl", "w.dev", "w.las", "m.gp"]),
     st.integers(0, 4),
     st.lists(mutation, min_size=1, max_size=4),
 )

@@ -16,7 +16,10 @@ from geobrep.ops.io import read, write
 from geobrep.plugins import registries
 
 DATA = Path(__file__).parent.parent / "data" / "gocad"
-GOCAD_FILES = sorted(p.name for p in DATA.glob("*") if p.suffix != ".md")
+#: The GOCAD files (not SOURCES.md, nor the ``@@`` property files a group's Voxet reads).
+GOCAD_FILES = sorted(
+    p.name for p in DATA.glob("*") if p.suffix != ".md" and not p.name.endswith("@@")
+)
 
 
 @pytest.fixture(scope="module")
@@ -84,6 +87,8 @@ def test_roundtrip_gocad_files(file_name: str, name: str, tmp_path: Path) -> Non
         pytest.skip("the GOCAD adapter is not installed")
     source = tmp_path / file_name
     shutil.copy(DATA / file_name, source)
+    for side in DATA.glob("*@@"):  # found beside the file that names them
+        shutil.copy(side, tmp_path / side.name)
     scene = read(source)
     spec = registries().formats.get(name)
     back = read(write(scene, tmp_path / f"out{spec.extensions[0]}", format=name))

@@ -10,7 +10,8 @@ import geobrep
 from geobrep.adapters.gocad._parser import GocadWarning
 
 DATA = Path(__file__).resolve().parent.parent / "data" / "gocad"
-FILES = sorted(p.name for p in DATA.iterdir() if p.suffix != ".md")
+#: The GOCAD files (not SOURCES.md, nor the ``@@`` property files of their grids).
+FILES = sorted(p.name for p in DATA.iterdir() if p.suffix != ".md" and not p.name.endswith("@@"))
 
 
 def read_quietly(path: Path | str, **options: Any) -> geobrep.Scene:

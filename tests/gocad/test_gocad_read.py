@@ -33,7 +33,7 @@ EXPECTED = {
     "surf2d_multi.ts": ({"Surface": 2}, 6, 0),
     "ts-2props.ts": ({"Surface": 1}, 1, 0),
     "header_only_fault.ts": ({"Surface": 2}, 0, 0),  # F3_fault: a header, no vertices
-    "voxet_and_tsurf.gp": ({"Surface": 1}, 0, 0),  # the Voxet is skipped (no reader)
+    "voxet_and_tsurf.gp": ({"RegularGrid": 1, "Surface": 1}, 0, 0),  # + porosity_grid@@
 }
 
 

@@ -17,7 +17,7 @@ from geobrep.model.base import arrays_identical
 
 @pytest.mark.parametrize("name", FILES)
 def test_read_write_read_is_identical(name: str, tmp_path: Path) -> None:
-    # what the reader skipped (a Voxet, an SGrid) is not in the scene, so not in the written file
+    # what the reader skipped (sgrid_tsurf.ts's SGrid) is not in the scene, so not in the file
     first = without_read_losses(read_quietly(DATA / name))
     out = write_quietly(first, tmp_path / name)
     second = read_quietly(out)
@@ -25,9 +25,13 @@ def test_read_write_read_is_identical(name: str, tmp_path: Path) -> None:
     for a, b in zip(first.entities, second.entities, strict=True):
         if hasattr(a, "vertices"):
             assert arrays_identical(a.vertices, b.vertices)
-    # and the written file is stable: writing it again gives the same bytes
-    again = write_quietly(second, tmp_path / f"again_{name}")
+    # and the written file is stable: writing it again (under the same name, which its side
+    # files' names come from) gives the same bytes
+    (tmp_path / "again").mkdir()
+    again = write_quietly(second, tmp_path / "again" / name)
     assert again.read_bytes() == out.read_bytes()
+    for side in sorted(tmp_path.glob("*@@")):
+        assert (tmp_path / "again" / side.name).read_bytes() == side.read_bytes()
 
 
 def test_writer_output_conventions(tmp_path: Path) -> None:
