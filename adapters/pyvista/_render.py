@@ -1,14 +1,15 @@
 """Pictures of a scene, off-screen (no display needed): the ``png`` format's writer.
 
-Colour by ``entity`` (one colour per mesh entity), ``block`` (the closed boundary of every
-block, one colour per unit) or ``property`` (a named point or cell property, one colour
-scale); optionally cut away everything on the side of a plane its normal points to, or draw a
-section: the model cut by a plane (blocks closed by the cut, so the units show as filled
-areas), looked at square to it. Pictures carry a legend (unit or entity names with their
-colours), a box of axes labelled in world coordinates, a scale bar and a title naming the CRS.
-Colours are those of the glTF and HTML outputs (:func:`geobrep.adapters.colors.scene_colours`).
-Coordinates are centred on the scene before rendering, so UTM-scale models draw without
-float32 jitter.
+Grids are drawn as their (active) cells, wells as their traces with their markers labelled
+(:mod:`geobrep.adapters.pyvista._grids`). Colour by ``entity`` (one colour per mesh entity),
+``block`` (the closed boundary of every block, one colour per unit) or ``property`` (a named
+point or cell property, one colour scale); optionally cut away everything on the side of a
+plane its normal points to, or draw a section: the model cut by a plane (blocks closed by the
+cut, so the units show as filled areas), looked at square to it. Pictures carry a legend (unit
+or entity names with their colours), a box of axes labelled in world coordinates, a scale bar
+and a title naming the CRS. Colours are those of the glTF and HTML outputs
+(:func:`geobrep.adapters.colors.scene_colours`). Coordinates are centred on the scene before
+rendering, so UTM-scale models draw without float32 jitter.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from geobrep.adapters.pyvista._convert import (
     scene_blocks_to_pyvista,
     to_pyvista,
 )
+from geobrep.adapters.pyvista._grids import MARKER_NAMES, grid_and_well_datasets
 from geobrep.errors import OptionsError
 from geobrep.model.entities import Block, Entity
 from geobrep.model.scene import Scene
@@ -114,6 +116,8 @@ def _datasets(scene: Scene, options: RenderOptions) -> list[tuple[str, Any]]:
         dataset = multiblock[index]
         if dataset is not None and dataset.n_points:
             items.append((multiblock.get_block_name(index) or str(index), dataset))
+    if options.color_by != "block":
+        items.extend((label, dataset) for label, dataset, _ in grid_and_well_datasets(scene))
     if not items:
         raise OptionsError("nothing to draw: the scene has no mesh entities")
     if options.color_by == "property":
@@ -199,6 +203,8 @@ def _render(pv: Any, scene: Scene, path: Path, options: RenderOptions) -> None:
     colours = _colours(scene, sources)
     clim = _property_range(items, options.property) if options.color_by == "property" else None
     drawn = 0
+    labels: list[tuple[Any, list[str]]] = []  # marker names, drawn last (after the scalar bar)
+    bar_mapper: Any = None  # the scalar bar is that of a mesh coloured by the property
     for (label, dataset), colour in zip(items, colours, strict=True):
         mesh = dataset.copy()
         points = np.asarray(mesh.points, dtype=np.float64) - centre
@@ -210,12 +216,17 @@ def _render(pv: Any, scene: Scene, path: Path, options: RenderOptions) -> None:
         mesh = _cut(mesh, options, centre, scale)
         if mesh.n_points == 0:
             continue
-        _add(plotter, mesh, label, colour[:3], clim, options)
+        actor = _add(plotter, mesh, label, colour[:3], clim, options)
+        if bar_mapper is None and clim is not None and _has(mesh, options.property):
+            bar_mapper = actor.mapper
+        names = mesh.field_data.get(MARKER_NAMES)
+        if names is not None and len(names) == mesh.n_points:
+            labels.append((mesh.points, [str(n) for n in names]))
         drawn += 1
     if not drawn:
         raise OptionsError("the clip or section plane cuts everything away")
     if options.color_by == "property" and options.property is not None:
-        plotter.add_scalar_bar(title=options.property)
+        plotter.add_scalar_bar(title=options.property, mapper=bar_mapper)
     elif options.legend:
         entries = _legend_entries(items, sources, colours)
         width, height = 0.2, min(0.045 * len(entries) + 0.02, 0.6)
@@ -228,6 +239,10 @@ def _render(pv: Any, scene: Scene, path: Path, options: RenderOptions) -> None:
         )
         legend.SetPosition(1.0 - width - 0.01, 1.0 - height - 0.07)  # below the title line
         legend.SetPosition2(width, height)
+    for points, names in labels:
+        plotter.add_point_labels(
+            points, names, font_size=14, point_size=10, shape_opacity=0.6, always_visible=True
+        )
     _decorate(plotter, scene, lows, highs, centre, scale, options)
     plotter.screenshot(str(path))
     plotter.close()
@@ -240,22 +255,21 @@ def _add(
     colour: tuple[float, ...],
     clim: tuple[float, float] | None,
     options: RenderOptions,
-) -> None:
+) -> Any:
     style: dict[str, Any] = {"show_edges": options.show_edges}
     if mesh.n_cells and mesh.get_cell(0).dimension < 2:
         style["line_width" if mesh.get_cell(0).dimension == 1 else "point_size"] = 4
     name = options.property
-    if (
-        clim is not None
-        and name is not None
-        and (name in mesh.point_data or name in mesh.cell_data)
-    ):
+    if clim is not None and name is not None and _has(mesh, name):
         preference = "point" if name in mesh.point_data else "cell"
-        plotter.add_mesh(
+        return plotter.add_mesh(
             mesh, scalars=name, clim=clim, preference=preference, cmap="viridis", **style
         )
-    else:
-        plotter.add_mesh(mesh, color=colour if clim is None else "lightgrey", **style)
+    return plotter.add_mesh(mesh, color=colour if clim is None else "lightgrey", **style)
+
+
+def _has(mesh: Any, name: str | None) -> bool:
+    return name is not None and (name in mesh.point_data or name in mesh.cell_data)
 
 
 def _nice_length(span: float) -> float:

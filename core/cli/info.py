@@ -101,10 +101,36 @@ def _grid_counts(entity: Entity) -> dict[str, int]:
     return {}
 
 
+def _details(entity: Entity) -> dict[str, Any] | None:
+    """What a user checks of a grid (its lattice) or a well (its depths and picks)."""
+    if isinstance(entity, RegularGrid):
+        return {
+            "origin": entity.origin.tolist(),
+            "axes": entity.axes.tolist(),
+            "cell_size": [float(v) for v in (entity.axes**2).sum(axis=1) ** 0.5],
+        }
+    if isinstance(entity, StructuredGrid):
+        return {"geometry": "corner-point" if entity.is_corner_point else "points"}
+    if isinstance(entity, Well):
+        md = entity.md.tolist()
+        return {
+            "head": entity.head.tolist(),
+            "md": [md[0], md[-1]] if md else [],
+            "datum": entity.datum,
+            "datum_elevation": entity.datum_elevation,
+            "markers": [{"name": m.name, "md": m.md, "surface": m.surface} for m in entity.markers],
+            "zones": [
+                {"name": z.name, "top_md": z.top_md, "base_md": z.base_md} for z in entity.zones
+            ],
+            "logs": list(entity.logs),
+        }
+    return None
+
+
 def describe_entity(entity: Entity) -> dict[str, Any]:
-    """A JSON-ready summary of one entity."""
+    """A JSON-ready summary of one entity (grids and wells add ``details``)."""
     bounds = entity.bounds
-    return {
+    summary = {
         "id": entity.id,
         "type": type(entity).__name__,
         "name": entity.name,
@@ -114,6 +140,41 @@ def describe_entity(entity: Entity) -> dict[str, Any]:
         "point_data": _properties(entity.point_data),
         "cell_data": _properties(entity.cell_data),
     }
+    details = _details(entity)
+    if details is not None:
+        summary["details"] = details
+    return summary
+
+
+#: Markers listed one a line by the text form of ``info`` (the JSON form has them all).
+MARKER_LINES = 10
+
+
+def _detail_lines(details: dict[str, Any]) -> list[str]:
+    if "cell_size" in details:
+        size = " × ".join(f"{v:g}" for v in details["cell_size"])
+        origin = ", ".join(f"{v:.3f}" for v in details["origin"])
+        return [f"      lattice origin ({origin}), cells {size}"]
+    if "geometry" in details:
+        return [f"      geometry {details['geometry']}"]
+    if "md" not in details or not details["md"]:
+        return []
+    datum = details["datum"] or "-"
+    if details["datum_elevation"] is not None:
+        datum += f" at {details['datum_elevation']:g}"
+    head = ", ".join(f"{v:.3f}" for v in details["head"])
+    lines = [f"      MD {details['md'][0]:g} .. {details['md'][1]:g} from ({head}), datum {datum}"]
+    markers = details["markers"]
+    for marker in markers[:MARKER_LINES]:
+        hits = f" -> {marker['surface']}" if marker["surface"] else ""
+        lines.append(f"      marker {marker['name']!r} at MD {marker['md']:g}{hits}")
+    if len(markers) > MARKER_LINES:
+        lines.append(f"      ... {len(markers) - MARKER_LINES} more markers (--json lists them)")
+    for zone in details["zones"]:
+        lines.append(f"      zone {zone['name']!r} MD {zone['top_md']:g} .. {zone['base_md']:g}")
+    if details["logs"]:
+        lines.append(f"      logs {', '.join(details['logs'])}")
+    return lines
 
 
 #: CRS names GOCAD and SKUA give a model built in local coordinates (``Default``, ``SKUA Local``,
@@ -244,6 +305,7 @@ def render_text(summary: dict[str, Any], source: str) -> str:
         counts = ", ".join(f"{v} {k}" for k, v in entity["counts"].items())
         kind = f" [{entity['kind']}]" if entity["kind"] else ""
         lines.append(f"  #{entity['id']} {entity['type']} {entity['name']!r}{kind}: {counts}")
+        lines.extend(_detail_lines(entity.get("details") or {}))
         for where in ("point_data", "cell_data"):
             for prop in entity[where]:
                 unit = f" {prop['unit']}" if prop["unit"] else ""
