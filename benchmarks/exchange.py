@@ -158,7 +158,8 @@ def _h5py_direct(
 ) -> tuple[Callable[[], Any], Callable[[], Any]]:
     """The geoh5 objects geobrep writes, by h5py: the workspace's groups and types, the
     Surface object (x, y, z records, int32 cells) and its vertex data with their attributes;
-    read back as a Surface holds them (float64 points, int64 triangles, the data)."""
+    read back as a Surface holds them (float64 points, the int32 triangles as stored, the
+    data)."""
     import h5py
 
     path = folder / "direct.geoh5"
@@ -199,7 +200,7 @@ def _h5py_direct(
             for obj in store["GEOSCIENCE/Objects"].values():
                 rows = obj["Vertices"][()]
                 np.column_stack([rows["x"], rows["y"], rows["z"]])
-                obj["Cells"][()].astype(np.int64)
+                obj["Cells"][()]
                 for data in obj["Data"].values():
                     data["Data"][()]
 

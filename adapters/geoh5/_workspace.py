@@ -163,16 +163,19 @@ def write_geoh5(scene: Scene, path: Path) -> None:
 # -- reading ------------------------------------------------------------------------------------
 
 
-def _check_sizes(store: h5py.File, path: Path) -> None:
-    total = 0
+def _nbytes(item: Any) -> int:
+    return int(item.size) * item.dtype.itemsize if isinstance(item, h5py.Dataset) else 0
 
-    def add(name: str, item: Any) -> None:
-        nonlocal total
-        if isinstance(item, h5py.Dataset):
-            total += int(item.size) * item.dtype.itemsize
 
-    store.visititems(add)
-    check_declared(total, path.stat().st_size, "its datasets", path)
+def _declared(obj: h5py.Group) -> int:
+    """Bytes the datasets geobrep may read of ``obj`` declare (its own, its data's values and
+    their value maps), from their metadata alone."""
+    total = sum(_nbytes(item) for item in obj.values())
+    for data in obj.get("Data", {}).values():
+        total += _nbytes(data.get("Data"))
+        kind = data.get("Type")
+        total += 0 if kind is None else _nbytes(kind.get("Value map"))
+    return total
 
 
 def _read_data(obj: h5py.Group, association: str, n: int, order: Any = None) -> PropertyMap:
@@ -210,6 +213,14 @@ def _block_model(obj: h5py.Group, name: str, ident: int) -> Entity:
     return grid_entity(grid, name, cells, {}, id=ident)
 
 
+def _cells(stored: NDArray[Any]) -> NDArray[np.int64] | NDArray[np.int32]:
+    """Cells as stored when they are int32 (surfaces: the entity holds them as they are, no
+    copy), other integers as int64."""
+    if stored.dtype == np.int32:
+        return stored
+    return np.asarray(stored, dtype=np.int64)
+
+
 def _object(obj: h5py.Group, ident: int, skipped: list[str]) -> Entity | None:
     """The entity of ``obj`` with id ``ident`` (given here: a Scene giving ids would validate
     each entity again), or None for a type geobrep does not read; what it holds and geobrep
@@ -226,11 +237,7 @@ def _object(obj: h5py.Group, ident: int, skipped: list[str]) -> Entity | None:
     points = _read_data(obj, "Vertex", len(vertices))
     if kind == "Points":
         return PointSet(vertices=vertices, name=name, point_data=points, id=ident)
-    cells = (
-        np.asarray(obj["Cells"][()], dtype=np.int64)
-        if "Cells" in obj
-        else np.zeros((0, 3), np.int64)
-    )
+    cells = _cells(obj["Cells"][()]) if "Cells" in obj else np.zeros((0, 3), np.int64)
     cell_data = _read_data(obj, "Cell", len(cells))
     if kind == "Surface":
         return Surface(
@@ -241,8 +248,9 @@ def _object(obj: h5py.Group, ident: int, skipped: list[str]) -> Entity | None:
             cell_data=cell_data,
             id=ident,
         )
+    segments = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
     return chain_segments(
-        vertices, cells.reshape(-1, 2), cell_data, {"name": name, "point_data": points, "id": ident}
+        vertices, segments, cell_data, {"name": name, "point_data": points, "id": ident}
     )
 
 
@@ -250,13 +258,15 @@ def read_geoh5(path: Path) -> Scene:
     """The scene of the geoh5 workspace ``path``."""
     try:
         with h5py.File(path, "r") as store:
-            _check_sizes(store, path)
+            budget, declared = path.stat().st_size, 0
             if "GEOSCIENCE" not in store:
                 raise FormatError("not a geoh5 workspace (no GEOSCIENCE group)", path)
             root = store["GEOSCIENCE"]
             entities: list[Entity] = []
             skipped: list[str] = []
             for ident, obj in root.get("Objects", {}).items():
+                declared += _declared(obj)  # before any of it is read
+                check_declared(declared, budget, "its objects' datasets", path)
                 try:
                     entity = _object(obj, len(entities), skipped)
                 except GeobrepError as exc:

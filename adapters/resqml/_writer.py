@@ -24,7 +24,7 @@ from geobrep.model.crs import CRS
 from geobrep.model.entities import Block, Entity, PointSet, PolyLine, Surface
 from geobrep.model.properties import PropertyMap
 from geobrep.model.scene import Scene
-from geobrep.ops.temporaries import parse_temporary, temporary_path
+from geobrep.ops.temporaries import parse_temporary, replace_file, temporary_path
 
 __all__ = ["PATCH_PROPERTY", "write_resqml"]
 
@@ -62,10 +62,12 @@ def write_resqml(scene: Scene, path: Path, offset: tuple[float, float, float] | 
             warnings.simplefilter("ignore")  # resqpy's notes on local property kinds
             _fill_model(model, scene, offset)
             model.store_epc()
-        os.replace(work / f"{stem}.h5", folder / f"{stem}.h5")
+        replace_file(work / f"{stem}.h5", folder / f"{stem}.h5")
         os.replace(work / f"{stem}.epc", path)
+        work.rmdir()  # empty now
     finally:
-        shutil.rmtree(work, ignore_errors=True)
+        if work.exists():
+            shutil.rmtree(work, ignore_errors=True)
 
 
 def _fill_model(model: Any, scene: Scene, offset: tuple[float, float, float] | None) -> None:

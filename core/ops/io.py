@@ -10,7 +10,6 @@ True
 
 from __future__ import annotations
 
-import os
 import re
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
@@ -21,7 +20,7 @@ from typing import Any
 from geobrep.errors import FileAccessError, FormatError, GeobrepError, UnknownFormatError
 from geobrep.model.entities import Entity
 from geobrep.model.scene import Scene
-from geobrep.ops.temporaries import remove_stale_temporaries, temporary_path
+from geobrep.ops.temporaries import remove_stale_temporaries, replace_file, temporary_path
 
 __all__ = ["as_scene", "atomic_write", "read", "write"]
 
@@ -54,7 +53,7 @@ def atomic_write(path: PathArg) -> Iterator[Path]:
         yield temporary
         if not temporary.exists():
             raise FormatError("the writer produced no file", final)
-        os.replace(temporary, final)
+        replace_file(temporary, final)
     finally:
         if temporary.exists():
             temporary.unlink()

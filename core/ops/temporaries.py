@@ -25,14 +25,17 @@ Example:
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import secrets
 import shutil
+import stat
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 __all__ = [
     "LEGACY_STALE_AGE",
@@ -40,9 +43,11 @@ __all__ = [
     "TEMPORARY_PATTERN",
     "Temporary",
     "find_temporaries",
+    "finish_freeing",
     "parse_legacy_temporary",
     "parse_temporary",
     "remove_stale_temporaries",
+    "replace_file",
     "temporary_path",
 ]
 
@@ -73,6 +78,72 @@ def temporary_path(final: Path, suffix: str | None = None) -> Path:
     ending = "".join(final.suffixes[-1:]) if suffix is None else suffix
     token = secrets.token_hex(4)
     return final.with_name(f".{final.stem}.tmp-{os.getpid()}-{token}{ending}")
+
+
+BACKGROUND_FREE_BYTES = 8 << 20
+"""A replaced file at least this large (8 MiB) is unlinked by a background thread."""
+
+_freeing: list[Any] = []
+"""The one thread that unlinks replaced files (made on first use; joined at exit)."""
+
+
+def _free_later(path: Path) -> None:
+    if not _freeing:
+        from concurrent.futures import ThreadPoolExecutor
+
+        _freeing.append(ThreadPoolExecutor(max_workers=1, thread_name_prefix="geobrep-free"))
+    _freeing[0].submit(_unlink_quietly, path)
+
+
+def finish_freeing() -> None:
+    """Wait until every file :func:`replace_file` replaced is unlinked."""
+    if _freeing:
+        _freeing[0].submit(lambda: None).result()
+
+
+def _unlink_quietly(path: Path) -> None:
+    # on an error it is left as a stale temporary: the next write or ``geobrep clean`` finds it
+    with contextlib.suppress(OSError):
+        path.unlink(missing_ok=True)
+
+
+def replace_file(source: Path, target: Path) -> None:
+    """``os.replace(source, target)``, as atomic, without waiting for the replaced file's
+    blocks to be freed.
+
+    Freeing a large file (tens of milliseconds for tens of MB on ext4, the cost of a whole
+    write of a small model) is the slow part of a rename onto an existing file. A regular file
+    of at least :data:`BACKGROUND_FREE_BYTES` that ``target`` names keeps a second name, a
+    temporary of this process beside ``target``; ``source`` is renamed onto ``target`` (readers
+    see the old file or the new one, never neither), and a background thread unlinks the
+    temporary (the interpreter waits for it at exit; :func:`finish_freeing` waits now). Should
+    the process die first, the temporary is stale and removed by the next write of ``target``
+    or ``geobrep clean``. Without hard links, a plain :func:`os.replace`.
+    """
+    try:
+        old = os.lstat(target)
+    except OSError:
+        old = None
+    large = (
+        old is not None
+        and stat.S_ISREG(old.st_mode)
+        and old.st_nlink == 1
+        and old.st_size >= BACKGROUND_FREE_BYTES
+    )
+    keep = temporary_path(target) if large else None
+    if keep is not None:
+        try:
+            os.link(target, keep)
+        except OSError:  # a file system without hard links, or the target just went
+            keep = None
+    try:
+        os.replace(source, target)
+    except BaseException:
+        if keep is not None:
+            _unlink_quietly(keep)
+        raise
+    if keep is not None:
+        _free_later(keep)
 
 
 def parse_temporary(name: str) -> tuple[int, str] | None:

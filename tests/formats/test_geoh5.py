@@ -203,3 +203,16 @@ def test_a_block_model_rotated_in_plan_keeps_its_rotation(tmp_path: Path) -> Non
     (back,) = read(path).entities
     assert isinstance(back, geobrep.RegularGrid)
     np.testing.assert_allclose(back.axes, grid.axes, rtol=0, atol=1e-12)
+
+
+def test_datasets_declaring_more_than_the_budget_are_refused_before_reading(
+    tmp_path: Path,
+) -> None:
+    path = write(_scene(), tmp_path / "m.geoh5")
+    with h5py.File(path, "r+") as store:
+        obj = next(iter(store["GEOSCIENCE/Objects"].values()))
+        data = next(iter(obj["Data"].values()))
+        del data["Data"]  # a value array of 10^10 floats, none of them stored: a tiny file
+        data.create_dataset("Data", shape=(10**10,), dtype="<f8", chunks=(4096,))
+    with pytest.raises(FormatError, match="its objects' datasets declares"):
+        read(path)

@@ -244,3 +244,75 @@ def test_a_write_removes_the_targets_day_old_temporaries_of_earlier_versions(
     assert not old.exists()
     assert recent.exists()
     assert other_target.exists()
+
+
+# -- replacing a large file without waiting for its blocks to be freed ---------------------------
+
+
+def _big(path: Path, byte: bytes) -> Path:
+    from geobrep.ops.temporaries import BACKGROUND_FREE_BYTES
+
+    path.write_bytes(byte * BACKGROUND_FREE_BYTES)
+    return path
+
+
+def test_replace_file_swaps_a_large_file_and_frees_the_old_one_later(tmp_path: Path) -> None:
+    from geobrep.ops.temporaries import finish_freeing, replace_file
+
+    target, source = _big(tmp_path / "m.h5", b"o"), _big(tmp_path / "new.h5", b"n")
+    old_inode = target.stat().st_ino
+    with target.open("rb") as reader:  # a reader of the old file keeps reading it whole
+        replace_file(source, target)
+        assert reader.read(4) == b"oooo"
+    assert target.read_bytes()[:4] == b"nnnn"
+    assert target.stat().st_ino != old_inode
+    finish_freeing()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.h5"]
+
+
+def test_replace_file_of_small_files_and_without_hard_links_is_a_rename(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from geobrep.ops.temporaries import finish_freeing, replace_file
+
+    def no_links(*_: object) -> None:
+        raise OSError("no hard links on this file system")
+
+    monkeypatch.setattr(os, "link", no_links)
+    small, source = tmp_path / "s.txt", tmp_path / "t.txt"
+    small.write_text("old")
+    source.write_text("new")
+    replace_file(source, small)  # small: os.link is not even tried
+    assert small.read_text() == "new"
+    target, source = _big(tmp_path / "m.h5", b"o"), _big(tmp_path / "n.h5", b"n")
+    replace_file(source, target)  # large, but os.link fails: a plain rename
+    finish_freeing()
+    assert target.read_bytes()[:1] == b"n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.h5", "s.txt"]
+
+
+def test_a_failed_replace_leaves_the_target_and_no_second_name(tmp_path: Path) -> None:
+    from geobrep.ops.temporaries import replace_file
+
+    target = _big(tmp_path / "m.h5", b"o")
+    with pytest.raises(FileNotFoundError):
+        replace_file(tmp_path / "missing.h5", target)
+    assert target.read_bytes()[:1] == b"o"
+    assert [p.name for p in tmp_path.iterdir()] == ["m.h5"]
+
+
+def test_a_write_over_a_large_file_leaves_only_the_file(tmp_path: Path) -> None:
+    from geobrep.ops.temporaries import BACKGROUND_FREE_BYTES, finish_freeing
+
+    side = 800
+    x, y = np.meshgrid(np.arange(side, dtype=float), np.arange(side, dtype=float))
+    points = geobrep.PointSet(vertices=np.column_stack([x.ravel(), y.ravel(), x.ravel() * 0]))
+    path = geobrep.write(points, tmp_path / "p.geobrep")
+    first = path.read_bytes()
+    assert len(first) >= BACKGROUND_FREE_BYTES  # freed in the background
+    moved = points.replace(vertices=points.vertices + 1.0)
+    geobrep.write(moved, path)
+    finish_freeing()
+    assert path.read_bytes() != first
+    assert [p.name for p in tmp_path.iterdir()] == ["p.geobrep"]
+    assert geobrep.read(path).entities[0].vertices.tobytes() == moved.vertices.tobytes()
