@@ -348,6 +348,7 @@ def batch(count: int, folder: Path) -> None:
     meshio_wall, _ = loop(meshio.read, lambda m, p: meshio.write(p, m), vtu_files, "meshio")
     format_wall, format_cpu = loop(geobrep.read, geobrep.write, ts_files, "geobrep")
     dask_wall = dask_cluster()
+    executor = _executor_overhead(ts_files[:200], out / "executor")
     rate = lambda wall: f"{count / wall:8.0f} files/s"  # noqa: E731
     print(f"  geobrep convert --jobs 2            {rate(wall2)}  ({wall2:.2f} s, {cpu2:.2f} s CPU)")
     print(f"  geobrep convert --jobs 1            {rate(wall1)}  ({wall1:.2f} s, {cpu1:.2f} s CPU)")
@@ -364,6 +365,42 @@ def batch(count: int, folder: Path) -> None:
         f"{per_file * 1e3:.2f} ms (a {few}-file run's {fixed_cpu:.2f} s start-up taken off), "
         f"the format work {format_cpu / count * 1e3:.2f} ms: overhead "
         f"{100 * (per_file * count / format_cpu - 1):+.0f} % (target ≤ 20 %)"
+    )
+    best, median = executor
+    print(
+        f"  executor overhead in one process (geobrep.convert ÷ a geobrep read → write loop, "
+        f"{len(ts_files[:200])} files, CPU, 5 runs each, alternating): best {best:+.0f} %, "
+        f"median {median:+.0f} % (target ≤ 20 %)"
+    )
+
+
+def _executor_overhead(files: list[Path], target: Path) -> tuple[float, float]:
+    """CPU of ``geobrep.convert`` over a plain read → write loop of the same files, in this
+    process (no start-up, no worker): best and median of 5 alternating runs, in per cent."""
+    import geobrep
+
+    target.mkdir(parents=True, exist_ok=True)
+
+    def loop() -> None:
+        for path in files:
+            geobrep.write(geobrep.read(path), target / f"{path.stem}.vtu")
+
+    def convert() -> None:
+        geobrep.convert(files, to="vtu", out_dir=target / "convert")
+
+    plain: Times = []
+    executor: Times = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        loop(), convert()
+        for _ in range(5):
+            for work, times in ((loop, plain), (convert, executor)):
+                start = time.process_time()
+                work()
+                times.append(time.process_time() - start)
+    return (
+        100 * (min(executor) / min(plain) - 1),
+        100 * (statistics.median(executor) / statistics.median(plain) - 1),
     )
 
 
