@@ -83,6 +83,20 @@ def calls(function: Callable[[], Any], repeat: int, warm_up: bool = True) -> Tim
     return times
 
 
+def interleaved(functions: dict[str, Callable[[], Any]], repeat: int) -> dict[str, Times]:
+    """Wall-clock seconds of ``repeat`` rounds that call each function once, in turn (after
+    one uncounted call of each): a shared machine's load falls on all of them alike."""
+    for function in functions.values():
+        function()
+    times: dict[str, Times] = {name: [] for name in functions}
+    for _ in range(repeat):
+        for name, function in functions.items():
+            start = time.perf_counter()
+            function()
+            times[name].append(time.perf_counter() - start)
+    return times
+
+
 #: The environment of the measured commands: bytecode is written (the warm-up run caches the
 #: .pyc files an installed package has; PYTHONDONTWRITEBYTECODE would recompile every run).
 ENV = {key: value for key, value in os.environ.items() if key != "PYTHONDONTWRITEBYTECODE"}
@@ -256,15 +270,17 @@ def blocks(repeat: int, quick: bool) -> None:
         oriented = geobrep.Scene(entities=truth.surfaces, crs=truth.crs)
         n = sum(s.n_faces for s in surfaces)
         runs = repeat if n < 500_000 else max(5, repeat // 2)
-        default = calls(lambda s=as_they_come: geobrep.build_blocks(s), runs)
-        bare = calls(
-            lambda s=as_they_come: geobrep.build_blocks(s, check_conformity=False, validate=False),
-            runs,
-        )
-        anchor = None
+        work: dict[str, Callable[[], Any]] = {
+            "default": lambda s=as_they_come: geobrep.build_blocks(s),
+            "bare": lambda s=as_they_come: geobrep.build_blocks(
+                s, check_conformity=False, validate=False
+            ),
+        }
         if cgal is not None:
             vertices, welded = welded_soup(oriented)
-            anchor = calls(lambda v=vertices, w=welded: cgal.extract_cells(v, w), runs)
+            work["anchor"] = lambda v=vertices, w=welded: cgal.extract_cells(v, w)
+        times = interleaved(work, runs)
+        default, bare, anchor = times["default"], times["bare"], times.get("anchor")
         row(
             f"build_blocks default, {label} ({n:,} triangles)",
             default,
