@@ -55,18 +55,21 @@ class Source:
 
     def __init__(self, path: Path, data: bytes) -> None:
         self.path = path
-        n_cr = data.count(b"\r")
-        if n_cr and n_cr != data.count(b"\r\n"):
-            data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
-            n_cr = 0
-        self.data = data
         buffer = np.frombuffer(data, dtype=np.uint8)
+        returns = np.flatnonzero(buffer == 13)
+        if returns.size:
+            after = np.take(buffer, returns + 1, mode="clip")
+            if returns[-1] == len(data) - 1 or (after != 10).any():  # lone CRs
+                data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+                buffer = np.frombuffer(data, dtype=np.uint8)
+                returns = returns[:0]
+        self.data = data
         breaks = np.flatnonzero(buffer == 10)
         self.starts = np.concatenate([[0], breaks + 1]).astype(np.int64)
         self.ends = np.concatenate([breaks, [len(data)]]).astype(np.int64)
         if self.starts[-1] == len(data):  # a final newline does not start a line
             self.starts, self.ends = self.starts[:-1], self.ends[:-1]
-        if n_cr:  # CRLF: a line ends before its CR
+        if returns.size:  # CRLF: a line ends before its CR
             before = np.take(buffer, np.maximum(self.ends - 1, 0))
             self.ends -= (before == 13) & (self.ends > self.starts)
 
