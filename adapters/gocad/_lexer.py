@@ -72,6 +72,10 @@ class Source:
         if returns.size:  # CRLF: a line ends before its CR
             before = np.take(buffer, np.maximum(self.ends - 1, 0))
             self.ends -= (before == 13) & (self.ends > self.starts)
+        self.runs: list[Run] = []
+        """Every bulk run of the file (filled by :func:`scan`)."""
+        self.batched: dict[int, NDArray[Any]] | None = None
+        """Run first line -> its numbers, parsed together with the runs like it."""
 
     @classmethod
     def read(cls, path: Path) -> Source:
@@ -127,16 +131,22 @@ def scan(source: Source) -> Iterator[Line | Run]:
         return
     change = np.flatnonzero(codes[1:] != codes[:-1]) + 1
     bounds = np.concatenate([[0], change, [n]])
-    for lo, hi in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
-        code = int(codes[lo])
-        if code:
-            yield Run(
-                BULK_KEYWORDS[code - 1],
-                lo + 1,
-                hi - lo,
-                int(source.starts[lo]),
-                int(source.ends[hi - 1]),
-            )
+    pairs = list(zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True))
+    source.runs = [
+        Run(
+            BULK_KEYWORDS[int(codes[lo]) - 1],
+            lo + 1,
+            hi - lo,
+            int(source.starts[lo]),
+            int(source.ends[hi - 1]),
+        )
+        for lo, hi in pairs
+        if codes[lo]
+    ]
+    runs = iter(source.runs)
+    for lo, hi in pairs:
+        if codes[lo]:
+            yield next(runs)
             continue
         for index in range(lo, hi):
             text = source.text(index).strip()
@@ -243,19 +253,15 @@ def parse_run(source: Source, run: Run, integer: bool) -> NDArray[Any]:
         raise BulkParseError
     keyword = run.keyword.encode()
     data = source.data
-    only_integers = (
-        data.find(b".", run.start, run.end) < 0
-        and data.find(b"e", run.start, run.end) < 0
-        and data.count(b"E", run.start, run.end) == run.count * keyword.count(b"E")
-    )
+    only_integers = _only_integers(data, run)
     if integer and not only_integers:
         raise BulkParseError  # "1.0", "1e0": the line parser says why they are no ids
-    rows = slice(run.first - 1, run.first - 1 + run.count)
-    starts = source.starts[rows] - run.start
-    # one blank ending a line (as many exporters leave) is no separator
-    ends = source.ends[rows] - run.start
-    view = np.frombuffer(data, dtype=np.uint8, count=run.end - run.start, offset=run.start)
-    trailing = ends[np.take(view, ends - 1) == 32] - 1
+    if source.batched is None:
+        source.batched = _parse_batches(source)
+    batched = source.batched.pop(run.first, None)
+    if batched is not None:
+        return batched
+    starts, trailing = _line_offsets(source, [run])
     with contextlib.suppress(BulkParseError):  # single blanks only: else renormalise, below
         return _parse_block(data, run.start, run.end, starts, len(keyword), only_integers, trailing)
     raw = _renormalised(data[run.start : run.end], keyword)
@@ -265,6 +271,65 @@ def parse_run(source: Source, run: Run, integer: bool) -> NDArray[Any]:
     starts = np.concatenate([[0], breaks + 1])
     none = np.zeros(0, dtype=np.int64)
     return _parse_block(raw, 0, len(raw), starts, len(keyword), only_integers, none)
+
+
+def _only_integers(data: bytes, run: Run) -> bool:
+    """No decimal point or exponent in the run (beyond the keyword's own letters)."""
+    keyword = run.keyword.encode()
+    return (
+        data.find(b".", run.start, run.end) < 0
+        and data.find(b"e", run.start, run.end) < 0
+        and data.count(b"E", run.start, run.end) == run.count * keyword.count(b"E")
+    )
+
+
+def _line_offsets(source: Source, runs: list[Run]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Where the lines of ``runs`` start and where a blank ends one (no separator, as many
+    exporters leave it), as offsets into the runs' text joined by line breaks."""
+    starts: list[NDArray[np.int64]] = []
+    ends: list[NDArray[np.int64]] = []
+    shift = 0
+    for run in runs:
+        rows = slice(run.first - 1, run.first - 1 + run.count)
+        starts.append(source.starts[rows] - run.start + shift)
+        ends.append(source.ends[rows] - run.start + shift)
+        shift += run.end - run.start + 1
+    start, end = np.concatenate(starts), np.concatenate(ends)
+    buffer = np.frombuffer(source.data, dtype=np.uint8)
+    absolute = np.concatenate([source.ends[r.first - 1 : r.first - 1 + r.count] for r in runs])
+    trailing = end[np.take(buffer, absolute - 1) == 32] - 1
+    return start, trailing
+
+
+def _parse_batches(source: Source) -> dict[int, NDArray[Any]]:
+    """The numbers of every run of two lines or more, parsed in one go with the runs of the
+    same keyword, kind (integers or not) and first-line width: ``{run first line: array}``.
+
+    A batch that the bulk parse rejects is left out, so each of its runs is parsed on its own
+    (and line by line where that fails): the same results, with exact error messages.
+    """
+    data = source.data
+    groups: dict[tuple[str, bool, int], list[Run]] = {}
+    for run in source.runs:
+        if run.count < 2:
+            continue
+        first_end = int(source.ends[run.first - 1])
+        width = data.count(b" ", run.start, first_end) - (data[first_end - 1] == 32)
+        groups.setdefault((run.keyword, _only_integers(data, run), width), []).append(run)
+    parsed: dict[int, NDArray[Any]] = {}
+    for (keyword, only_integers, _), runs in groups.items():
+        if len(runs) < 2:
+            continue
+        text = b"\n".join(data[run.start : run.end] for run in runs)
+        starts, trailing = _line_offsets(source, runs)
+        try:
+            block = _parse_block(text, 0, len(text), starts, len(keyword), only_integers, trailing)
+        except BulkParseError:
+            continue
+        cuts = np.cumsum([run.count for run in runs])[:-1]
+        for run, rows in zip(runs, np.split(block, cuts), strict=True):
+            parsed[run.first] = rows
+    return parsed
 
 
 def _parse_block(

@@ -73,3 +73,69 @@ def test_a_bad_id_in_a_crlf_patom_run_is_reported_on_its_line(tmp_path: Path) ->
     path.write_bytes(("\r\n".join(line + " " for line in lines) + "\r\n").encode())
     with pytest.raises(FormatError, match=r"bad\.ts:13"):
         _read(path)
+
+
+TWO_SURFACES = """GOCAD TSurf 1
+HEADER {
+name:a
+}
+PROPERTIES p
+TFACE
+PVRTX 1 0 0 0 1
+PVRTX 2 1 0 0 2
+PVRTX 3 0 1 0 3
+TRGL 1 2 3
+TFACE
+PVRTX 4 1 1 0 4
+PVRTX 5 2 1 0 5
+TRGL 2 4 3
+TRGL 4 5 2
+END
+GOCAD TSurf 1
+HEADER {
+name:b
+}
+PROPERTIES p q
+TFACE
+PVRTX 1 0 0 5 1 10
+PVRTX 2 1 0 5 2 20
+PVRTX 3 0 1 5 3 30
+TRGL 1 2 3
+TRGL 3 2 1
+END
+"""
+
+
+@pytest.mark.parametrize("flag", ["", " CNXYZ"])
+def test_runs_of_several_objects_parsed_together_read_as_each_alone(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, flag: str
+) -> None:
+    """Runs of one keyword and width are parsed in one batch; a run the batch cannot take
+    (a flag: the whole batch falls back) reads the same."""
+    path = tmp_path / "two.ts"
+    path.write_text(TWO_SURFACES.replace("PVRTX 5 2 1 0 5", "PVRTX 5 2 1 0 5" + flag))
+    together = _scene(path).surfaces
+    monkeypatch.setattr("geobrep.adapters.gocad._lexer.ORJSON", None)
+    alone = _scene(path).surfaces
+    assert [s.name for s in together] == ["a", "b"]
+    assert together[1].point_data["q"].values.tolist() == [10, 20, 30]
+    for x, y in zip(together, alone, strict=True):
+        assert np.array_equal(x.vertices, y.vertices)
+        assert np.array_equal(x.faces, y.faces)
+        assert np.array_equal(x.patch_labels, y.patch_labels)
+        assert dict(x.point_data).keys() == dict(y.point_data).keys()
+        for name in dict(x.point_data):
+            assert np.array_equal(x.point_data[name].values, y.point_data[name].values)
+
+
+def _scene(path: Path) -> geobrep.Scene:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return geobrep.read(path)
+
+
+def test_a_bad_id_in_a_batched_run_is_reported_on_its_line(tmp_path: Path) -> None:
+    path = tmp_path / "bad2.ts"
+    path.write_text(TWO_SURFACES.replace("TRGL 3 2 1", "TRGL 3 2 1.5"))
+    with pytest.raises(FormatError, match=r"bad2\.ts:27"):
+        _scene(path)
