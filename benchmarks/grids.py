@@ -1,6 +1,6 @@
 """Voxet and GRDECL read speed next to OpenGeode-GeosciencesIO, in the same run.
 
-Run: ``.venv/bin/python benchmarks/grids.py [--voxet 256] [--grdecl 200 200 50] [--repeat 3]``
+Run: ``.venv/bin/python benchmarks/grids.py [--voxet 256] [--grdecl 200 200 50] [--repeat 5]``
 
 * Voxet: a ``n³`` float32 property. geobrep reads it as GOCAD writes it (raw big-endian
   ``PROP_FILE``, memory-mapped) and as an ``ASCII_DATA_FILE`` table; OpenGeode-GeosciencesIO
@@ -8,13 +8,16 @@ Run: ``.venv/bin/python benchmarks/grids.py [--voxet 256] [--grdecl 200 200 50] 
 * GRDECL: an ``ni × nj × nk`` corner-point grid on slanted pillars with a fault throw and a
   PORO property; OpenGeode reads it with ``load_hybrid_solid3D``.
 
-Times are the best of ``--repeat`` runs; the ratio geobrep / OpenGeode is the figure to trust
-on a shared machine (goal ≤ 1.0).
+Each of ``--repeat`` (5) runs reads with geobrep, then with OpenGeode, so both meet the same
+load; printed are the best and median times and the ratios geobrep / OpenGeode of the best
+times and the median of the per-run ratios, the figures to trust on a shared machine (goal
+≤ 1.0).
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
 import tempfile
 import time
 import warnings
@@ -28,13 +31,26 @@ import geobrep
 from geobrep import Property, RegularGrid, StructuredGrid
 
 
-def best(repeat: int, work: Callable[[], Any]) -> tuple[float, Any]:
-    times, result = [], None
+def timed(work: Callable[[], Any]) -> tuple[float, Any]:
+    started = time.perf_counter()
+    result = work()
+    return time.perf_counter() - started, result
+
+
+def side_by_side(
+    repeat: int, ours: Callable[[], Any], theirs: Callable[[], Any] | None
+) -> tuple[list[float], list[float], Any, Any]:
+    """Each run times geobrep, then OpenGeode (the same load on both); all the times."""
+    mine: list[float] = []
+    other: list[float] = []
+    result = anchor = None
     for _ in range(repeat):
-        started = time.perf_counter()
-        result = work()
-        times.append(time.perf_counter() - started)
-    return min(times), result
+        seconds, result = timed(ours)
+        mine.append(seconds)
+        if theirs is not None:
+            seconds, anchor = timed(theirs)
+            other.append(seconds)
+    return mine, other, result, anchor
 
 
 def voxet(n: int) -> RegularGrid:
@@ -79,17 +95,21 @@ def opengeode() -> Any | None:
     return opengeode
 
 
-def _row(label: str, ours: float, theirs: float | None) -> str:
-    ratio = "-" if theirs is None else f"{ours / theirs:.2f}x"
-    other = "-" if theirs is None else f"{theirs:.3f} s"
-    return f"{label:<34} geobrep {ours:8.3f} s   OpenGeode {other:>9}   ratio {ratio}"
+def _row(label: str, ours: list[float], theirs: list[float]) -> str:
+    mine = f"geobrep best {min(ours):7.3f} s median {statistics.median(ours):7.3f} s"
+    if not theirs:
+        return f"{label:<32} {mine}   (OpenGeode not installed)"
+    best = min(ours) / min(theirs)
+    median = statistics.median(a / b for a, b in zip(ours, theirs, strict=True))
+    other = f"OpenGeode best {min(theirs):7.3f} s median {statistics.median(theirs):7.3f} s"
+    return f"{label:<32} {mine}   {other}   ratio best {best:.2f}x median {median:.2f}x"
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--voxet", type=int, default=256)
     parser.add_argument("--grdecl", type=int, nargs=3, default=(200, 200, 50))
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--repeat", type=int, default=5)
     args = parser.parse_args()
     og = opengeode()
     with tempfile.TemporaryDirectory() as folder, warnings.catch_warnings():
@@ -98,23 +118,28 @@ def main() -> None:
         grid = voxet(args.voxet)
         binary = geobrep.write(grid, root / "bin.vo")
         text = geobrep.write(grid, root / "text.vo", voxet_ascii=True)
-        ours_bin, back = best(args.repeat, lambda: geobrep.read(binary))
+        load_voxet = None if og is None else (lambda: og.load_regular_grid3D(str(text)))
+        ours_bin, theirs, back, loaded = side_by_side(
+            args.repeat, lambda: geobrep.read(binary), load_voxet
+        )
         assert back.entities[0].point_data["amplitude"] == grid.point_data["amplitude"]
-        ours_txt, _ = best(args.repeat, lambda: geobrep.read(text))
-        theirs = None
-        if og is not None:
-            theirs, loaded = best(args.repeat, lambda: og.load_regular_grid3D(str(text)))
+        if loaded is not None:
             assert loaded.nb_cells() == grid.n_points
+        ours_txt, theirs_txt, back, _ = side_by_side(
+            args.repeat, lambda: geobrep.read(text), load_voxet
+        )
+        assert back.entities[0].n_points == grid.n_points
         n = args.voxet
         print(_row(f"Voxet {n}^3 float32 (binary)", ours_bin, theirs))
-        print(_row(f"Voxet {n}^3 float32 (ASCII)", ours_txt, theirs))
+        print(_row(f"Voxet {n}^3 float32 (ASCII)", ours_txt, theirs_txt))
         cp = corner_point(*args.grdecl)
         path = geobrep.write(cp, root / "grid.grdecl")
-        ours, back = best(args.repeat, lambda: geobrep.read(path))
+        load_grdecl = None if og is None else (lambda: og.load_hybrid_solid3D(str(path)))
+        ours, theirs, back, solid = side_by_side(
+            args.repeat, lambda: geobrep.read(path), load_grdecl
+        )
         assert back.entities[0].n_cells == cp.n_cells
-        theirs = None
-        if og is not None:
-            theirs, solid = best(args.repeat, lambda: og.load_hybrid_solid3D(str(path)))
+        if solid is not None:
             assert solid.nb_polyhedra() == cp.n_cells
         ni, nj, nk = args.grdecl
         print(_row(f"GRDECL {ni}x{nj}x{nk} ({cp.n_cells:,} cells)", ours, theirs))

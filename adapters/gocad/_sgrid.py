@@ -19,7 +19,6 @@ node; a cell property's value is on the row of the cell's first corner.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -31,13 +30,14 @@ from geobrep.adapters.gocad._keyed import KeyedFile, KeyedLine, parse_keyed, rea
 from geobrep.adapters.gocad._objects import report
 from geobrep.adapters.gocad._voxet import (
     PropertyFile,
+    ascii_numbers,
     mapped_array,
     property_dtype,
     property_lines,
     property_meta,
     side_file,
 )
-from geobrep.adapters.limits import check_declared, parse_numbers
+from geobrep.adapters.limits import check_declared
 from geobrep.errors import EntityValidationError, FormatError
 from geobrep.model.entities import StructuredGrid
 from geobrep.model.properties import Property
@@ -198,11 +198,7 @@ def _ascii_rows(layout: SGridLayout, path: Path, n_props: int) -> NDArray[np.flo
         raise FormatError(f"the ASCII_DATA_FILE {str(side)!r} is missing", path)
     columns = 6 + n_props
     check_declared(8 * columns * layout.n_nodes, side.stat().st_size, "AXIS_N", side)
-    body = re.sub(r"(?m)^\s*[*#].*$", "", read_text(side, "ASCII data file"))
-    try:
-        numbers = parse_numbers(body)
-    except ValueError as exc:
-        raise FormatError(f"ASCII data file: {exc}", side) from None
+    numbers = ascii_numbers(side)
     if numbers.size != columns * layout.n_nodes:
         raise FormatError(
             f"ASCII data file: {numbers.size} numbers, {layout.n_nodes} nodes of {columns} "

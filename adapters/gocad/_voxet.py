@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.adapters.gocad._keyed import KeyedFile, KeyedLine, parse_keyed, read_text
-from geobrep.adapters.limits import check_declared, parse_numbers
+from geobrep.adapters.gocad._keyed import MAX_TEXT, KeyedFile, KeyedLine, parse_keyed, read_text
+from geobrep.adapters.limits import check_declared, human_bytes, parse_numbers
 from geobrep.errors import EntityValidationError, FormatError
 from geobrep.model.entities import RegularGrid
 from geobrep.model.properties import Property
@@ -30,6 +30,7 @@ from geobrep.model.properties import Property
 __all__ = [
     "PropertyFile",
     "VoxetAxes",
+    "ascii_numbers",
     "mapped_array",
     "property_dtype",
     "property_lines",
@@ -217,12 +218,7 @@ def _ascii_table(
         raise FormatError(f"the ASCII_DATA_FILE {str(side)!r} is missing", path)
     total = int(np.prod(counts))
     check_declared(8 * total * max(len(props), 1), side.stat().st_size, "AXIS_N", side)
-    text = read_text(side, "ASCII data file")
-    body = re.sub(r"(?m)^\s*[*#].*$", "", text)
-    try:
-        numbers = parse_numbers(body)
-    except ValueError as exc:
-        raise FormatError(f"ASCII data file: {exc}", side) from None
+    numbers = ascii_numbers(side)
     columns = 3 + len(props)
     if numbers.size % columns:
         raise FormatError(
@@ -242,6 +238,38 @@ def _ascii_table(
         values[index] = rows[:, 3 + column]
         out.append(values)
     return out
+
+
+def _after_leading_comments(data: bytes) -> bytes:
+    """``data`` from its first line that is not blank nor a ``*`` or ``#`` comment."""
+    start = 0
+    while start < len(data):
+        end = data.find(b"\n", start)
+        end = len(data) if end < 0 else end + 1
+        line = data[start:end].strip()
+        if line and line[:1] not in (b"*", b"#"):
+            break
+        start = end
+    return data[start:]
+
+
+def ascii_numbers(side: Path) -> NDArray[np.float64]:
+    """Every number of an ASCII data file (``*`` and ``#`` comment lines skipped), parsed from
+    its bytes in one C-level pass: the comment lines at its head are cut off, and only a file
+    with comments further down pays for a search of every line."""
+    try:
+        size = side.stat().st_size
+    except OSError as exc:
+        raise FormatError(f"cannot open the ASCII data file: {exc.strerror}", side) from None
+    if size > MAX_TEXT:
+        raise FormatError(f"the ASCII data file is {human_bytes(size)}, more than allowed", side)
+    body = _after_leading_comments(side.read_bytes())
+    if b"*" in body or b"#" in body:
+        body = re.sub(rb"(?m)^[ \t\r]*[*#].*$", b"", body)
+    try:
+        return parse_numbers(body)
+    except ValueError as exc:
+        raise FormatError(f"ASCII data file: {exc}", side) from None
 
 
 def read_voxet(

@@ -128,6 +128,22 @@ class TestVoxet:
             np.testing.assert_array_equal(back.point_data[name].values, prop.values)
             assert back.point_data[name].no_data_value == prop.no_data_value
 
+    @pytest.mark.parametrize("newline", ["\n", "\r\n"])
+    def test_ascii_comment_lines_anywhere_are_skipped(self, tmp_path: Path, newline: str) -> None:
+        grid = rotated_voxet()
+        out = geobrep.write(grid, tmp_path / "a.vo", voxet_ascii=True)
+        table = tmp_path / "a__ascii@@"
+        lines = table.read_text().split("\n")
+        edited = ["", "# made by hand", *lines[:10], "* a comment between rows", "", *lines[10:]]
+        table.write_bytes(newline.join(edited).encode())
+        back = geobrep.read(out).entities[0]
+        assert isinstance(back, RegularGrid)
+        for name, prop in grid.point_data.items():
+            np.testing.assert_array_equal(back.point_data[name].values, prop.values)
+        table.write_text("\n".join([*lines[:10], "12 x 0 0.5", *lines[10:]]))
+        with pytest.raises(FormatError, match="ASCII data file: 'x' is not a number"):
+            geobrep.read(out)
+
     def test_cell_data_is_written_at_the_cell_centres(self, tmp_path: Path) -> None:
         grid = rotated_voxet()
         cells = grid.replace(point_data={}, cell_data={"k": np.arange(60, dtype=np.float64)})
