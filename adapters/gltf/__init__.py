@@ -10,7 +10,8 @@ Registers two formats (extra ``web``; 3D Tiles also need pyproj, extra ``gis``):
   (``asset.extras.geobrep.float32_rounding_m``): about 0.2 mm for a 10 km model.
 - ``3dtiles``: a tileset JSON (any ``.json`` name; ``tileset.json`` by custom) and its content
   ``<stem>.glb`` beside it (a model of more than ``max_tile_triangles``: one ``<stem>_<n>.glb``
-  tile per surface, polyline, point set and block, each with its bounding box), in
+  tile per surface, polyline, point set and block, each with its bounding box, and a k-d
+  tree of tiles for each mesh larger than that), in
   east-north-up metres with the ENU-to-ECEF root transform from the scene's CRS (pyproj), so
   Cesium shows the model at its true place. A scene without a CRS is refused unless
   ``longitude``, ``latitude`` and ``height`` say where its centre goes.
@@ -80,7 +81,8 @@ class TilesOptions(BaseModel):
     blocks: bool = True
     max_tile_triangles: int = Field(default=MAX_TILE_TRIANGLES, ge=1)
     """A model with more triangles (segments, points) than this is written as one tile per
-    surface, polyline, point set and block, each with its bounding box."""
+    surface, polyline, point set and block, each with its bounding box; a surface, point set
+    or block boundary with more is split in space into tiles of at most this many."""
 
 
 def _origin(scene: Scene, origin: tuple[float, float, float] | None) -> OffsetFrame:

@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.gltf._frame import EnuFrame, Frame, OffsetFrame, from_y_up
-from geobrep.adapters.gltf._write import GEOBREP_KEY, import_pygltflib
+from geobrep.adapters.gltf._write import GEOBREP_KEY, TILE_PART_KEY, import_pygltflib
 from geobrep.errors import FormatError
 from geobrep.host.capabilities import SKIPPED_ON_READ
 from geobrep.model.crs import CRS
@@ -29,7 +29,7 @@ from geobrep.model.entities import Entity, PointSet, PolyLine, Surface
 from geobrep.model.properties import Property
 from geobrep.model.scene import Group, Scene
 
-__all__ = ["read_glb"]
+__all__ = ["read_glb", "read_glb_parts"]
 
 _COMPONENTS: Final = {5120: "i1", 5121: "u1", 5122: "<i2", 5123: "<u2", 5125: "<u4", 5126: "<f4"}
 _WIDTH: Final = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
@@ -241,16 +241,42 @@ def _foreign_primitive(
     raise FormatError(f"{name}: primitive mode {mode} (strips, fans, loops) is not read", file.path)
 
 
+def _place(file: _File, entry: Any) -> dict[str, Any]:
+    """Where a tile's piece of a split mesh sits in the whole (node extras ``tile_part``)."""
+    if not isinstance(entry, dict):
+        raise FormatError("extras.geobrep.tile_part is not an object", file.path)
+    out: dict[str, Any] = {}
+    for key, value in entry.items():
+        if key in ("vertex_ids", "cell_ids"):
+            out[key] = file.raw(value, f"tile part {key}").astype(np.int64)
+        elif key in ("key", "index", "count", "n_vertices", "n_cells"):
+            if not isinstance(value, int) or value < 0:
+                raise FormatError(f"tile part {key}: {value!r} is not a count", file.path)
+            out[key] = value
+    needed = {"key", "index", "count", "vertex_ids", "cell_ids", "n_vertices", "n_cells"}
+    missing = needed - set(out)
+    if missing:
+        raise FormatError(f"tile part without {', '.join(sorted(missing))}", file.path)
+    return out
+
+
 def read_glb(path: Path) -> Scene:
     """The scene in the .glb file ``path``."""
+    return read_glb_parts(path)[0]
+
+
+def read_glb_parts(path: Path) -> tuple[Scene, dict[int, dict[str, Any]]]:
+    """The scene in the .glb file ``path`` and, by entity position, where the pieces of split
+    meshes (one tile of a tileset) sit in their whole."""
     file = _File(path)
     asset_extras = file.gltf.asset.extras or {}
     own = asset_extras.get(GEOBREP_KEY) if isinstance(asset_extras, dict) else None
     if not isinstance(own, dict):
-        return Scene(entities=_foreign_entities(file), name=path.stem)
+        return Scene(entities=_foreign_entities(file), name=path.stem), {}
     crs = CRS.model_validate(own["crs"]) if own.get("crs") else None
     frame = _frame(own, crs, path)
     entities: list[Entity] = []
+    places: dict[int, dict[str, Any]] = {}
     skipped: list[str] = []
     for node in file.gltf.nodes:
         extras = node.extras if isinstance(node.extras, dict) else {}
@@ -260,14 +286,19 @@ def read_glb(path: Path) -> Scene:
             entity = _own_entity(file, node, frame)
         except (KeyError, TypeError, IndexError, AttributeError) as exc:
             raise FormatError(f"node {node.name!r}: {type(exc).__name__}: {exc}", path) from exc
-        if entity is None:
-            skipped.append(f"boundary mesh of {extras[GEOBREP_KEY].get('type')} {node.name!r}")
-        else:
-            entities.append(entity)
+        part = extras[GEOBREP_KEY].get(TILE_PART_KEY)
+        if entity is None:  # a block's boundary, listed once however many tiles it spans
+            if not isinstance(part, dict) or part.get("index") == 0:
+                skipped.append(f"boundary mesh of {extras[GEOBREP_KEY].get('type')} {node.name!r}")
+            continue
+        if part is not None:
+            places[len(entities)] = _place(file, part)
+        entities.append(entity)
     metadata = dict(own.get("metadata") or {})
     if skipped:
         metadata[SKIPPED_ON_READ] = skipped
     groups = [Group.model_validate(g) for g in own.get("groups", [])]
-    return Scene(
+    scene = Scene(
         entities=entities, groups=groups, crs=crs, name=own.get("name", ""), metadata=metadata
     )
+    return scene, places

@@ -3,10 +3,15 @@
 A small model is one tile; a large one (more than :data:`MAX_TILE_TRIANGLES`) one tile per
 surface, polyline, point set and block, each with its bounding box, under a root tile whose
 box holds them all and whose geometric error is the model's diagonal (a viewer refines to
-every tile). The tiles' glTF hold the meshes in east-north-up metres around the centre of the
-model's bounding box (:class:`~geobrep.adapters.gltf._frame.EnuFrame`, through pyproj from
-the scene's CRS to ECEF); the root tile's ``transform`` is the ENU-to-ECEF matrix, so Cesium
-(or any 3D Tiles viewer) draws the model at its true place. A scene without a usable CRS
+every tile). A surface, point set or block boundary larger than that is itself split in space
+(:mod:`._split`): a k-d tree of tiles without content, each with its children's box and its
+diagonal as geometric error, over leaf tiles of at most that many triangles, so a viewer
+loads only the leaves in view; reading puts the pieces back together exactly.
+
+The tiles' glTF hold the meshes in east-north-up metres around the centre of the model's
+bounding box (:class:`~geobrep.adapters.gltf._frame.EnuFrame`, through pyproj from the scene's
+CRS to ECEF); the root tile's ``transform`` is the ENU-to-ECEF matrix, so Cesium (or any 3D
+Tiles viewer) draws the model at its true place. A scene without a usable CRS
 needs the georeference from the user: the longitude, latitude and height where the centre of
 the model goes.
 """
@@ -21,7 +26,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.gltf._frame import EnuFrame
-from geobrep.adapters.gltf._read import read_glb
+from geobrep.adapters.gltf._read import read_glb_parts
+from geobrep.adapters.gltf._split import Part, SplitTree, leaves, reassemble, split_mesh, splittable
 from geobrep.adapters.gltf._write import GEOBREP_KEY, build_glb, glb_meshes
 from geobrep.errors import FormatError, OptionsError
 from geobrep.host.capabilities import SKIPPED_ON_READ
@@ -103,19 +109,99 @@ def _cells(geometry: Entity) -> int:
     return geometry.n_points if isinstance(geometry, PointSet) else geometry.n_cells
 
 
-def _tiles(
-    meshes: list[tuple[Entity, Entity]], max_tile_triangles: int
-) -> list[list[tuple[Entity, Entity]]]:
-    """One tile for a model of at most ``max_tile_triangles``, else one per mesh."""
-    if len(meshes) < 2 or sum(_cells(g) for g, _ in meshes) <= max_tile_triangles:
-        return [meshes]
-    return [[mesh] for mesh in meshes]
+_Mesh = tuple[Entity, Entity, dict[str, Any] | None]
+"""A mesh of a tile: geometry, the entity it shows, where it sits in a split whole (or None)."""
+_Plan = list[_Mesh] | tuple[list["_Plan"]]
+"""A tile's content (its meshes), or a tile without content over its children."""
+
+
+def _place(part: Part, key: int, index: int, count: int) -> dict[str, Any]:
+    return {
+        "key": key,
+        "index": index,
+        "count": count,
+        "n_vertices": part.n_vertices,
+        "n_cells": part.n_cells,
+        "vertex_ids": part.vertex_ids,
+        "cell_ids": part.cell_ids,
+    }
+
+
+def _split_plan(tree: SplitTree, key: int, count: int, numbers: list[int]) -> _Plan:
+    if isinstance(tree, Part):
+        numbers[0] += 1
+        return [(tree.geometry, tree.source, _place(tree, key, numbers[0] - 1, count))]
+    return ([_split_plan(half, key, count, numbers) for half in tree],)
+
+
+def _plan(meshes: list[tuple[Entity, Entity]], limit: int) -> list[_Plan]:
+    """The tiles under the root: one for a model of at most ``limit`` triangles (segments,
+    points); else one per mesh, and a k-d tree of tiles of at most ``limit`` for a surface or
+    point set larger than that (polylines stay whole)."""
+    if sum(_cells(g) for g, _ in meshes) <= limit:
+        return [[(g, s, None) for g, s in meshes]]
+    plans: list[_Plan] = []
+    for key, (geometry, source) in enumerate(meshes):
+        if _cells(geometry) <= limit or not splittable(geometry):
+            plans.append([(geometry, source, None)])
+            continue
+        tree = split_mesh(geometry, source, limit)
+        plans.append(_split_plan(tree, key, len(leaves(tree)), [0]))
+    return plans
+
+
+def _padded(low: NDArray[np.float64], high: NDArray[np.float64]) -> tuple[Any, Any]:
+    """``low .. high`` widened to at least 2 mm on each axis (a flat mesh gets a thin box)."""
+    centre, half = (low + high) / 2, np.maximum((high - low) / 2, 1e-3)
+    return centre - half, centre + half
 
 
 def _box(low: NDArray[np.float64], high: NDArray[np.float64]) -> list[float]:
     """A 3D Tiles bounding box (centre, then the three half-axes) around ``low .. high``."""
     centre, half = (low + high) / 2, np.maximum((high - low) / 2, 1e-3)
     return [float(v) for v in (*centre, half[0], 0, 0, 0, half[1], 0, 0, 0, half[2])]
+
+
+class _TileWriter:
+    """Writes the content tiles of a plan beside the tileset and makes their tile JSON."""
+
+    def __init__(self, scene: Scene, written: Scene, path: Path, frame: EnuFrame, **how: Any):
+        self.scene, self.written, self.path, self.frame, self.how = scene, written, path, frame, how
+        self.stem, self.count = _stem(path), 0
+
+    def tile(self, plan: _Plan, alone: bool) -> tuple[dict[str, Any], Any, Any]:
+        """The tile JSON of ``plan`` and its padded box (``low``, ``high``)."""
+        if isinstance(plan, tuple):
+            tiles = [self.tile(child, False) for child in plan[0]]
+            low = np.min([t[1] for t in tiles], axis=0)
+            high = np.max([t[2] for t in tiles], axis=0)
+            tile = {
+                "boundingVolume": {"box": _box(low, high)},
+                "geometricError": float(np.linalg.norm(high - low)),
+                "children": [t[0] for t in tiles],
+            }
+            return tile, low, high
+        content = build_glb(
+            self.scene,
+            self.frame,
+            written=self.written,
+            meshes=[(g, s) for g, s, _ in plan],
+            places=[p for _, _, p in plan],
+            # the groups name entities of many tiles: the tileset holds them, not each tile
+            extras=None if alone else {"groups": []},
+            **self.how,
+        )
+        name = f"{self.stem}.glb" if alone else f"{self.stem}_{self.count}.glb"
+        self.count += 1
+        with atomic_write(self.path.parent / name) as temporary:
+            temporary.write_bytes(content.data)
+        low, high = content.local_low, content.local_high
+        if not content.meshes or not np.isfinite(low).all():
+            low = high = np.zeros(3)
+        low, high = _padded(low, high)
+        tile = {"boundingVolume": {"box": _box(low, high)}, "geometricError": 0.0}
+        tile["content"] = {"uri": name}
+        return tile, low, high
 
 
 def write_tileset(
@@ -127,44 +213,21 @@ def write_tileset(
     blocks: bool,
     max_tile_triangles: int = MAX_TILE_TRIANGLES,
 ) -> None:
-    """``path`` (the tileset JSON) and its content beside it: ``<stem>.glb``, or one
-    ``<stem>_<n>.glb`` tile per surface, polyline, point set and block when the model has more
-    than ``max_tile_triangles`` triangles (segments, points), children of a root tile without
-    content whose box holds them all."""
-    groups = _tiles(glb_meshes(scene, blocks, written), max_tile_triangles)
-    stem, children = _stem(path), []
-    low, high = np.full(3, np.inf), np.full(3, -np.inf)
-    # the groups name entities of many tiles: the tileset holds them, not each tile
-    alone: dict[str, Any] | None = None if len(groups) == 1 else {"groups": []}
-    for number, group in enumerate(groups):
-        content = build_glb(
-            scene, frame, blocks=blocks, written=written, meshes=group, extras=alone
-        )
-        name = f"{stem}.glb" if len(groups) == 1 else f"{stem}_{number}.glb"
-        with atomic_write(path.parent / name) as temporary:
-            temporary.write_bytes(content.data)
-        if content.meshes:
-            low = np.minimum(low, content.local_low)
-            high = np.maximum(high, content.local_high)
-        children.append(
-            {
-                "boundingVolume": {"box": _box(content.local_low, content.local_high)},
-                "geometricError": 0.0,
-                "content": {"uri": name},
-            }
-        )
-    if not np.isfinite(low).all():
-        low = high = np.zeros(3)
+    """``path`` (the tileset JSON) and its content beside it: ``<stem>.glb`` for a model of at
+    most ``max_tile_triangles`` triangles (segments, points); else ``<stem>_<n>.glb`` tiles, one
+    per polyline, small surface, point set and block, and a k-d tree of tiles of at most
+    ``max_tile_triangles`` for each larger surface, point set or block boundary, under a root
+    tile without content whose box holds them all (:mod:`._split`)."""
+    plans = _plan(glb_meshes(scene, blocks, written), max_tile_triangles)
+    writer = _TileWriter(scene, written, path, frame, blocks=blocks)
+    plan = plans[0] if len(plans) == 1 else (plans,)
+    top, low, high = writer.tile(plan, isinstance(plan, list))
     error = float(np.linalg.norm(high - low))
     root: dict[str, Any] = {
         "transform": [float(v) for v in frame.ecef_matrix.T.ravel()],  # column-major
-        "boundingVolume": {"box": _box(low, high)},
+        **top,
         "refine": "ADD",
     }
-    if len(children) == 1:
-        root.update(geometricError=0.0, content=children[0]["content"])
-    else:
-        root.update(geometricError=error, children=children)
     tileset = {
         "asset": {
             "version": "1.1",
@@ -230,14 +293,35 @@ def _content(uri: str, path: Path) -> Path:
     return target
 
 
+def _gathered(tiles: list[tuple[Scene, dict[int, dict[str, Any]]]], path: Path) -> list[Entity]:
+    """The entities of the tiles in order, each split mesh put back together where its first
+    piece was."""
+    entities: list[Entity | int] = []
+    pieces: dict[int, list[tuple[Entity, dict[str, Any]]]] = {}
+    for scene, places in tiles:
+        for number, entity in enumerate(scene.entities):
+            place = places.get(number)
+            if place is None:
+                entities.append(entity)
+                continue
+            if place["key"] not in pieces:
+                entities.append(place["key"])
+            pieces.setdefault(place["key"], []).append((entity, place))
+    wholes = {
+        key: reassemble(sorted(parts, key=lambda p: int(p[1]["index"])), str(path))
+        for key, parts in pieces.items()
+    }
+    return [wholes[e] if isinstance(e, int) else e for e in entities]
+
+
 def read_tileset(path: Path) -> Scene:
     """The scene of a tileset geobrep wrote: the entities of its tiles' glTF contents (beside
-    it), in tile order, with the scene fields of the first."""
+    it), in tile order, split meshes put back together, with the scene fields of the first."""
     document = _tileset(path)
     uris = _content_uris(document["root"], path)
-    scenes = [read_glb(_content(uri, path)) for uri in uris]
-    first = scenes[0]
-    if len(scenes) == 1:
+    tiles = [read_glb_parts(_content(uri, path)) for uri in uris]
+    first = tiles[0][0]
+    if len(tiles) == 1 and not tiles[0][1]:
         return first
     extras = (document.get("asset") or {}).get("extras") or {}
     own = extras.get(GEOBREP_KEY) if isinstance(extras, dict) else None
@@ -245,10 +329,8 @@ def read_tileset(path: Path) -> Scene:
         groups = [Group.model_validate(g) for g in (own or {}).get("groups", [])]
     except (TypeError, ValueError) as exc:
         raise FormatError(f"bad groups in asset.extras.geobrep: {exc}", path) from exc
-    skipped = [s for scene in scenes for s in scene.metadata.get(SKIPPED_ON_READ, [])]  # type: ignore[union-attr]
+    skipped = [s for scene, _ in tiles for s in scene.metadata.get(SKIPPED_ON_READ, [])]  # type: ignore[union-attr]
     metadata = {k: v for k, v in first.metadata.items() if k != SKIPPED_ON_READ}
     if skipped:
         metadata[SKIPPED_ON_READ] = skipped
-    return first.replace(
-        entities=[e for scene in scenes for e in scene.entities], groups=groups, metadata=metadata
-    )
+    return first.replace(entities=_gathered(tiles, path), groups=groups, metadata=metadata)

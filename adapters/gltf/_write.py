@@ -29,9 +29,11 @@ from geobrep.model.entities import Block, Entity, PolyLine, Surface
 from geobrep.model.properties import PropertyMap
 from geobrep.model.scene import Scene
 
-__all__ = ["GEOBREP_KEY", "GlbContent", "build_glb", "glb_meshes", "write_glb"]
+__all__ = ["GEOBREP_KEY", "TILE_PART_KEY", "GlbContent", "build_glb", "glb_meshes", "write_glb"]
 
 GEOBREP_KEY: Final = "geobrep"
+TILE_PART_KEY: Final = "tile_part"
+"""The node extras key of a tile's piece of a mesh the tileset split (see :mod:`._split`)."""
 FORMAT_VERSION: Final = 1
 _FLOAT, _UINT, _USHORT = 5126, 5125, 5123
 _ARRAY_BUFFER, _ELEMENT_BUFFER = 34962, 34963
@@ -160,8 +162,10 @@ def _add_mesh(
     geometry: Entity,
     source: Entity,
     colour: RGBA,
+    place: dict[str, Any] | None = None,
 ) -> None:
-    """One node, mesh and material for ``geometry`` (``source`` is the entity it shows)."""
+    """One node, mesh and material for ``geometry`` (``source`` is the entity it shows;
+    ``place``: where a tile's piece of a split mesh sits in the whole, arrays kept exactly)."""
     world = np.asarray(geometry.vertices, np.float64)  # type: ignore[attr-defined]
     local = frame.to_local(world)
     y_up = to_y_up(local)
@@ -204,6 +208,10 @@ def _add_mesh(
     )
     out.meshes.append({"name": label, "primitives": [primitive]})
     extras = _entity_extras(buffer, source)
+    if place is not None:
+        extras[TILE_PART_KEY] = {
+            k: buffer.raw(v) if isinstance(v, np.ndarray) else v for k, v in place.items()
+        }
     out.nodes.append({"name": label, "mesh": len(out.meshes) - 1, "extras": {GEOBREP_KEY: extras}})
     unit = source.unit_name if isinstance(source, Block) else None
     out.rows.append(
@@ -261,21 +269,25 @@ def build_glb(
     written: Scene | None = None,
     extras: dict[str, Any] | None = None,
     meshes: list[tuple[Entity, Entity]] | None = None,
+    places: list[dict[str, Any] | None] | None = None,
 ) -> GlbContent:
     """The .glb bytes of ``scene`` in ``frame``.
 
     ``written`` is what the file keeps as entities (``scene`` restricted to the format); the
     blocks' meshes come from the full ``scene``. ``meshes`` (from :func:`glb_meshes`) picks
-    some of them: one tile of a tileset.
+    some of them: one tile of a tileset; ``places`` (beside ``meshes``) says which of them are
+    pieces of a mesh the tileset split, and where they sit in it.
     """
     pygltflib = import_pygltflib("writing glTF files")
     kept = written if written is not None else scene
     colours = scene_colours(scene)
     buffer, out = _Buffer(), _Meshes()
     default = (0.7, 0.7, 0.7, 1.0)
-    for geometry, source in glb_meshes(scene, blocks, written) if meshes is None else meshes:
+    chosen = glb_meshes(scene, blocks, written) if meshes is None else meshes
+    for number, (geometry, source) in enumerate(chosen):
         colour = default if source.id is None else colours.get(source.id, default)
-        _add_mesh(out, buffer, frame, geometry, source, colour)
+        place = None if places is None else places[number]
+        _add_mesh(out, buffer, frame, geometry, source, colour, place)
     scene_extras: dict[str, Any] = {
         "version": FORMAT_VERSION,
         "name": kept.name,

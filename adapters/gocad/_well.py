@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from geobrep.adapters.gocad._headers import quote_rest
+from geobrep.adapters.gocad._headers import quote, quote_rest
 from geobrep.adapters.gocad._keyed import KeyedLine, parse_keyed, read_text
 from geobrep.adapters.gocad._numbers import format_float
 from geobrep.adapters.gocad._objects import crs_block, z_sign_of
@@ -186,9 +186,9 @@ def well_text(well: Well, crs: CRS | None) -> str:
     for md, (x, y, z) in zip(well.md, well.vertices, strict=True):
         lines.append(f"PATH {_f(md)} {_f(z * sign)} {_f(x - head[0])} {_f(y - head[1])}")
     for marker in well.markers:
-        lines.append(f"MRKR {quote_rest(marker.name)} 0 {_f(marker.md)}")
+        lines.append(f"MRKR {quote(marker.name)} 0 {_f(marker.md)}")
     for zone in well.zones:
-        lines.append(f"ZONE {quote_rest(zone.name)} {_f(zone.top_md)} {_f(zone.base_md)} 0")
+        lines.append(f"ZONE {quote(zone.name)} {_f(zone.top_md)} {_f(zone.base_md)} 0")
     for name, log in well.logs.items():
         lines += ["WELL_CURVE", f"PROPERTY {name}"]
         if log.unit:

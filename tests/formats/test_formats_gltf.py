@@ -384,7 +384,8 @@ def test_single_tile_tileset_follows_the_tile_rules(tmp_path: Path) -> None:
 
 def test_tileset_tree_damage_is_a_format_error(tmp_path: Path) -> None:
     scene = geobrep.datasets.faulted_layer_cake()
-    tileset = write(scene, tmp_path / "tileset.json", max_tile_triangles=1)
+    n_triangles = sum(s.n_faces for s in scene.surfaces)
+    tileset = write(scene, tmp_path / "tileset.json", max_tile_triangles=n_triangles - 1)
     document = json.loads(tileset.read_text())
     document["root"]["children"][1]["content"]["uri"] = "../outside.glb"
     tileset.write_text(json.dumps(document))
@@ -397,4 +398,89 @@ def test_tileset_tree_damage_is_a_format_error(tmp_path: Path) -> None:
     document["root"]["children"] = []
     tileset.write_text(json.dumps(document))
     with pytest.raises(FormatError, match="no content"):
+        read(tileset)
+
+
+def _leaf_parts(root: dict, folder: Path) -> list[tuple[int, int, dict]]:
+    """``(depth, triangles, tile_part)`` of every split piece in the tree's leaves."""
+    found, stack = [], [(root, 0)]
+    while stack:
+        tile, depth = stack.pop()
+        stack.extend((child, depth + 1) for child in tile.get("children", []))
+        if "content" not in tile:
+            continue
+        gltf = pygltflib.GLTF2.load(str(folder / tile["content"]["uri"]))
+        for node in gltf.nodes:
+            part = node.extras["geobrep"].get("tile_part")
+            if part is not None:
+                indices = gltf.accessors[gltf.meshes[node.mesh].primitives[0].indices]
+                found.append((depth, indices.count // 3, part))
+    return found
+
+
+def test_large_surfaces_are_split_in_space_and_read_back_whole(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    blocks = [b for b in scene.blocks if b is not scene.universe]
+    largest = max(scene.surfaces, key=lambda s: s.n_faces)
+    limit = largest.n_faces // 5
+    tileset = write(scene, tmp_path / "tileset.json", max_tile_triangles=limit)
+    document = json.loads(tileset.read_text())
+    root = document["root"]
+    contents = _check_tile(root, document["geometricError"], tmp_path, True)
+    pieces = _leaf_parts(root, tmp_path)
+    assert contents > len(scene.surfaces) + len(blocks)  # more tiles than meshes
+    assert max(depth for depth, _, _ in pieces) >= 4  # root, mesh node, halvings, leaf
+    assert all(triangles <= limit for _, triangles, _ in pieces)
+    # every triangle of a split surface is in exactly one leaf
+    by_key: dict[int, list[dict]] = {}
+    for _, _, part in pieces:
+        by_key.setdefault(part["key"], []).append(part)
+    split_sizes = sorted(parts[0]["n_cells"] for parts in by_key.values())
+    assert largest.n_faces in split_sizes
+    for parts in by_key.values():
+        assert sorted(p["index"] for p in parts) == list(range(parts[0]["count"]))
+    # read back: the same scene as one tile gives, each surface whole and exact but for float32
+    back = read(tileset)
+    single = read(write(scene, tmp_path / "single.json"))
+    assert back == single
+    assert len(back.metadata[SKIPPED_ON_READ]) == len(blocks)
+    for original, again, whole in zip(scene.surfaces, back.surfaces, single.surfaces, strict=True):
+        assert (again.id, again.name) == (original.id, original.name)
+        assert np.array_equal(again.faces, original.faces)
+        assert np.array_equal(again.vertices, whole.vertices)  # the same float32 values
+        assert np.abs(again.vertices - original.vertices).max() < MILLIMETRE
+        assert again.area == pytest.approx(original.area, rel=1e-8)  # float32 rounding
+        assert again.point_data == original.point_data
+        assert again.cell_data == original.cell_data
+
+
+def test_a_large_point_set_is_split_with_its_properties(tmp_path: Path) -> None:
+    rng = np.random.default_rng(7)
+    points = rng.random((5_000, 3)) * [2_000.0, 3_000.0, 500.0] + [450_000.0, 6_700_000.0, -900.0]
+    cloud = PointSet(
+        vertices=points,
+        name="survey",
+        point_data={"depth": points[:, 2].copy(), "class": rng.integers(0, 9, 5_000)},
+    )
+    scene = Scene(entities=[cloud], crs=geobrep.CRS(epsg=32631))
+    tileset = write(scene, tmp_path / "tileset.json", max_tile_triangles=700)
+    document = json.loads(tileset.read_text())
+    assert _check_tile(document["root"], document["geometricError"], tmp_path, True) == 8
+    back = read(tileset).entities[0]
+    assert isinstance(back, PointSet)
+    assert back.name == "survey"
+    assert np.abs(back.vertices - points).max() < MILLIMETRE
+    assert np.array_equal(back.point_data["depth"].values, points[:, 2])
+    assert np.array_equal(back.point_data["class"].values, cloud.point_data["class"].values)
+
+
+def test_a_split_surface_missing_a_tile_is_a_format_error(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    limit = max(s.n_faces for s in scene.surfaces) // 3
+    tileset = write(scene, tmp_path / "tileset.json", max_tile_triangles=limit)
+    document = json.loads(tileset.read_text())
+    halving = next(c for c in document["root"]["children"] if "children" in c)
+    halving["children"].pop()
+    tileset.write_text(json.dumps(document))
+    with pytest.raises(FormatError, match="tiles"):
         read(tileset)

@@ -214,6 +214,18 @@ class TestWell:
         back = geobrep.read(geobrep.write(scene, tmp_path / "w.wl"))
         assert back.entities[0].replace(metadata={}) == scene.entities[0]
 
+    def test_marker_and_zone_names_with_spaces_survive(self, tmp_path: Path) -> None:
+        well = deviated_well().replace(
+            id=0,
+            markers=(WellMarker(name="top A", md=200.0), WellMarker(name=" base  B", md=512.75)),
+            zones=(WellZone(name="unit one", top_md=200.0, base_md=512.75),),
+        )
+        scene = Scene(entities=[well], crs=CRS(name="local"))
+        back = geobrep.read(geobrep.write(scene, tmp_path / "w.wl")).entities[0]
+        assert isinstance(back, Well)
+        assert [m.name for m in back.markers] == ["top A", " base  B"]
+        assert [z.name for z in back.zones] == ["unit one"]
+
     def test_marker_surfaces_are_reported_lost(self, tmp_path: Path) -> None:
         well = deviated_well()
         hit = well.replace(markers=(WellMarker(name="H1", md=200.0, surface="top"),))
