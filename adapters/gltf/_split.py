@@ -150,6 +150,9 @@ def _scatter(
 
 
 def _covered(ids: list[IntArray], size: int, what: str) -> None:
+    """Check that the leaves' ``ids`` name every one of the whole's ``size`` elements."""
+    if size > sum(len(where) for where in ids):  # before allocating what the file claims
+        raise ValueError(f"the tiles hold fewer {what} than the {size} of the whole")
     seen = np.zeros(size, bool)
     for where in ids:
         if len(where) and (where.min() < 0 or where.max() >= size):
@@ -164,6 +167,9 @@ def _whole(parts: list[tuple[Entity, dict[str, Any]]]) -> Entity:
     n_vertices, n_cells = int(info["n_vertices"]), int(info["n_cells"])
     vertex_ids = [np.asarray(p[1]["vertex_ids"], np.int64) for p in parts]
     _covered(vertex_ids, n_vertices, "vertices")
+    for (leaf, _), where in zip(parts, vertex_ids, strict=True):
+        if len(where) != len(leaf.vertices):  # type: ignore[attr-defined]
+            raise ValueError(f"a tile has {len(leaf.vertices)} vertices and {len(where)} ids")  # type: ignore[attr-defined]
     vertices = np.zeros((n_vertices, 3))
     for (leaf, _), where in zip(parts, vertex_ids, strict=True):
         vertices[where] = leaf.vertices  # type: ignore[attr-defined]
@@ -173,6 +179,8 @@ def _whole(parts: list[tuple[Entity, dict[str, Any]]]) -> Entity:
     assert isinstance(first, Surface)
     cell_ids = [np.asarray(p[1]["cell_ids"], np.int64) for p in parts]
     _covered(cell_ids, n_cells, "triangles")
+    if any(len(w) != p[0].n_cells for p, w in zip(parts, cell_ids, strict=True)):
+        raise ValueError("a tile's triangle ids do not match its triangles")
     faces = np.zeros((n_cells, 3), np.int64)
     labels = None if first.patch_labels is None else np.zeros(n_cells, np.int64)
     for (leaf, _), where, ids in zip(parts, cell_ids, vertex_ids, strict=True):

@@ -158,14 +158,17 @@ def _padded(low: NDArray[np.float64], high: NDArray[np.float64]) -> tuple[Any, A
 
 def _box(low: NDArray[np.float64], high: NDArray[np.float64]) -> list[float]:
     """A 3D Tiles bounding box (centre, then the three half-axes) around ``low .. high``."""
-    centre, half = (low + high) / 2, np.maximum((high - low) / 2, 1e-3)
+    low, high = _padded(low, high)
+    centre, half = (low + high) / 2, (high - low) / 2
     return [float(v) for v in (*centre, half[0], 0, 0, 0, half[1], 0, 0, 0, half[2])]
 
 
 class _TileWriter:
     """Writes the content tiles of a plan beside the tileset and makes their tile JSON."""
 
-    def __init__(self, scene: Scene, written: Scene, path: Path, frame: EnuFrame, **how: Any):
+    def __init__(
+        self, scene: Scene, written: Scene, path: Path, frame: EnuFrame, **how: Any
+    ) -> None:
         self.scene, self.written, self.path, self.frame, self.how = scene, written, path, frame, how
         self.stem, self.count = _stem(path), 0
 

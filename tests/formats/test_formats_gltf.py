@@ -484,3 +484,22 @@ def test_a_split_surface_missing_a_tile_is_a_format_error(tmp_path: Path) -> Non
     tileset.write_text(json.dumps(document))
     with pytest.raises(FormatError, match="tiles"):
         read(tileset)
+
+
+def test_a_tile_claiming_a_huge_whole_is_a_format_error(tmp_path: Path) -> None:
+    scene = geobrep.datasets.faulted_layer_cake()
+    limit = max(s.n_faces for s in scene.surfaces) // 3
+    tileset = write(scene, tmp_path / "tileset.json", max_tile_triangles=limit)
+    leaf = next(p for p in sorted(tmp_path.glob("tileset_*.glb")) if _has_part(p))
+    gltf = pygltflib.GLTF2.load(str(leaf))
+    for node in gltf.nodes:
+        if "tile_part" in node.extras["geobrep"]:
+            node.extras["geobrep"]["tile_part"]["n_vertices"] = 10**12  # not allocated
+    gltf.save_binary(str(leaf))
+    with pytest.raises(FormatError, match="fewer vertices"):
+        read(tileset)
+
+
+def _has_part(glb: Path) -> bool:
+    nodes = pygltflib.GLTF2.load(str(glb)).nodes
+    return any("tile_part" in node.extras["geobrep"] for node in nodes)
