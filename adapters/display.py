@@ -2,6 +2,9 @@
 
 Shared by the glTF writer and the HTML viewer: a block has no mesh of its own, so it is shown
 as :meth:`~geobrep.model.scene.Scene.block_mesh` (the universe, the outside, is not drawn).
+Grids and wells (:func:`drawn_grids_and_wells`, the HTML viewer) are the outer boundary of
+their active cells (:func:`~geobrep.adapters._grid_boundary.grid_boundary`) and the polyline of
+their stations; the markers are the wells' own (:meth:`~geobrep.Well.marker_positions`).
 
 >>> import geobrep
 >>> scene = geobrep.datasets.faulted_layer_cake()
@@ -11,10 +14,19 @@ as :meth:`~geobrep.model.scene.Scene.block_mesh` (the universe, the outside, is 
 
 from __future__ import annotations
 
-from geobrep.model.entities import Entity, PointSet, PolyLine, Surface
+from geobrep.adapters._grid_boundary import grid_boundary
+from geobrep.model.entities import (
+    Entity,
+    PointSet,
+    PolyLine,
+    RegularGrid,
+    StructuredGrid,
+    Surface,
+    Well,
+)
 from geobrep.model.scene import Scene
 
-__all__ = ["drawn_meshes"]
+__all__ = ["drawn_grids_and_wells", "drawn_meshes"]
 
 
 def drawn_meshes(scene: Scene, blocks: bool = True) -> list[tuple[Entity, Entity]]:
@@ -29,4 +41,25 @@ def drawn_meshes(scene: Scene, blocks: bool = True) -> list[tuple[Entity, Entity
         for block in copies.blocks:
             if block is not copies.universe and block.sides:
                 pairs.append((copies.block_mesh(block), block))
+    return pairs
+
+
+def drawn_grids_and_wells(scene: Scene, property: str | None = None) -> list[tuple[Entity, Entity]]:
+    """``(geometry, source)`` pairs for the grids (the Surface of their boundary, carrying the
+    property ``property`` where the grid has it) and the wells with two stations or more (the
+    PolyLine through their stations), in scene order.
+
+    >>> import geobrep
+    >>> well = geobrep.Well(head=[0, 0, 0], vertices=[[0, 0, 0], [0, 0, -5]], md=[0, 5])
+    >>> [(g.type, s.type) for g, s in drawn_grids_and_wells(geobrep.Scene(entities=[well]))]
+    [('PolyLine', 'Well')]
+    """
+    pairs: list[tuple[Entity, Entity]] = []
+    for entity in scene.entities:
+        if isinstance(entity, RegularGrid | StructuredGrid):
+            pairs.append((grid_boundary(entity, property), entity))
+        elif isinstance(entity, Well) and entity.n_stations >= 2:
+            stations = [range(entity.n_stations)]
+            trace = PolyLine.from_parts(entity.vertices, stations, name=entity.name)
+            pairs.append((trace, entity))
     return pairs

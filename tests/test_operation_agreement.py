@@ -83,7 +83,7 @@ WRITERS: dict[str, tuple[str, dict[str, Any]]] = {
             "vertical_exaggeration": 2.5,
         },
     ),
-    "view": ("html", {"title": "T", "blocks": False, "all_surfaces": True}),
+    "view": ("html", {"title": "T", "blocks": False, "all_surfaces": True, "property": "p"}),
 }
 #: Options every step that writes a file has: where its file goes and whether it may be empty.
 OUTPUT_KEYS = {"name", "allow_empty"}

@@ -2,10 +2,13 @@
 
 ``geobrep view MODEL -o model.html`` (or ``geobrep.write(scene, "model.html")``) writes one
 self-contained page: three.js r187 (MIT, vendored with its licence) and the model inlined, no
-server and no network needed. It lists the blocks, surfaces, lines and point sets with their
-names and colours (blocks by unit), each switchable; a clipping plane across x, y or z cuts
-the model open; a box of axes is labelled in world coordinates; the title and CRS head the
-list. The page reports what it shows on the browser console (``geobrep-view: {...}``).
+server and no network needed. It lists the blocks, surfaces, lines, point sets, grids and
+wells with their names and colours (blocks by unit), each switchable: a grid is drawn as the
+outer boundary of its active cells (coloured by a cell or point property with ``property``), a
+well as its trajectory with its markers, named in the view and the list; a clipping plane
+across x, y or z cuts the model open; a box of axes is labelled in world coordinates; the title
+and CRS head the list. The page reports what it shows on the browser console
+(``geobrep-view: {...}``).
 """
 
 from __future__ import annotations
@@ -22,7 +25,9 @@ from geobrep.model.scene import Scene
 __all__ = ["CAPABILITIES", "HtmlOptions", "geobrep_register_formats", "page_html"]
 
 CAPABILITIES = FormatCapabilities(
-    entity_types=frozenset({"Block", "PointSet", "PolyLine", "Surface"}),
+    entity_types=frozenset(
+        {"Block", "PointSet", "PolyLine", "RegularGrid", "StructuredGrid", "Surface", "Well"}
+    ),
     names=True,
     crs=True,
     multiple_entities=True,
@@ -40,6 +45,8 @@ class HtmlOptions(BaseModel):
     """Show the blocks (their boundaries, coloured by unit)."""
     surfaces_with_blocks: bool = False
     """With blocks shown, start with the surfaces shown too (else only faults are)."""
+    property: str | None = None
+    """Colour the grids by this cell or point property (a grid without it: its colour)."""
 
 
 def _write(scene: Scene, path: Path, options: HtmlOptions) -> None:
@@ -48,6 +55,7 @@ def _write(scene: Scene, path: Path, options: HtmlOptions) -> None:
         title=options.title,
         blocks=options.blocks,
         surfaces_with_blocks=options.surfaces_with_blocks,
+        property=options.property,
     )
     path.write_text(text, encoding="utf-8")
 

@@ -17,10 +17,19 @@ from typing import Any
 
 import numpy as np
 
-from geobrep.adapters.colors import hex_colour, scene_colours
-from geobrep.adapters.display import drawn_meshes
+from geobrep.adapters.colors import hex_colour, known_values, ramp_colours, scene_colours
+from geobrep.adapters.display import drawn_grids_and_wells, drawn_meshes
 from geobrep.errors import OptionsError
-from geobrep.model.entities import Block, Entity, PolyLine, Surface
+from geobrep.model.entities import (
+    Block,
+    Entity,
+    PolyLine,
+    RegularGrid,
+    StructuredGrid,
+    Surface,
+    Well,
+)
+from geobrep.model.properties import Property
 from geobrep.model.scene import Scene
 
 __all__ = ["page_html"]
@@ -53,6 +62,12 @@ def _object(
     }
     if isinstance(source, Block):
         entry["detail"] = source.unit_name or ""
+    if isinstance(source, Well):
+        _add_markers(entry, source, origin)
+    if isinstance(source, RegularGrid | StructuredGrid) and isinstance(geometry, Surface):
+        entry["detail"] = " × ".join(str(n) for n in source.counts)
+        if geometry.cell_data or geometry.point_data:
+            return _coloured(entry, geometry, vertices)
     indices = None
     if isinstance(geometry, Surface):
         indices = np.asarray(geometry.faces)
@@ -66,18 +81,75 @@ def _object(
     return entry
 
 
+def _add_markers(entry: dict[str, Any], well: Well, origin: np.ndarray[Any, Any]) -> None:
+    """The well's markers: their points and names (labelled in the view, listed in the panel)."""
+    if not well.markers:
+        return
+    at = well.marker_positions() - origin
+    entry["markers"] = {
+        "positions": _b64(at.astype("<f4")),
+        "names": [m.name or m.surface for m in well.markers],
+    }
+    entry["detail"] = ", ".join(entry["markers"]["names"])
+
+
+def _coloured(
+    entry: dict[str, Any], boundary: Surface, vertices: np.ndarray[Any, Any]
+) -> dict[str, Any]:
+    """A grid's boundary coloured by its property: per vertex (a point property) or per face
+    (a cell property: each triangle gets its own three vertices)."""
+    name, prop = next(iter({**boundary.point_data, **boundary.cell_data}.items()))
+    faces = np.asarray(boundary.faces)
+    colours = _property_colours(prop)
+    if name in boundary.cell_data:
+        vertices = vertices[faces].reshape(-1, 3)
+        colours = np.repeat(colours, 3, axis=0)
+        faces = np.arange(vertices.shape[0]).reshape(-1, 3)
+    values = np.asarray(prop.values, dtype=np.float64)
+    known = values[known_values(values, _no_data(prop))]
+    span = f" {known.min():.4g} – {known.max():.4g}" if known.size else ""
+    entry["detail"] = f"{entry['detail']}, {name}{span}"
+    entry["positions"] = _b64(vertices.astype("<f4"))
+    entry["indices"] = _b64(faces.astype("<u4"))
+    entry["count"] = int(faces.size)
+    entry["colours"] = _b64(colours)
+    return entry
+
+
+def _property_colours(prop: Property) -> np.ndarray[Any, Any]:
+    values = np.asarray(prop.values)
+    if values.ndim != 1 or values.dtype.kind not in "biuf":
+        raise OptionsError("property: only a numeric scalar property colours a grid")
+    return ramp_colours(values, _no_data(prop))
+
+
+def _no_data(prop: Property) -> float | None:
+    return None if prop.no_data_value is None else float(prop.no_data_value)
+
+
 def page_html(
     scene: Scene,
     *,
     title: str | None = None,
     blocks: bool = True,
     surfaces_with_blocks: bool = False,
+    property: str | None = None,
 ) -> str:
     """The page showing ``scene``. With blocks drawn, the surfaces start hidden (the blocks
-    cover them) unless ``surfaces_with_blocks``."""
-    pairs = drawn_meshes(scene, blocks)
+    cover them) unless ``surfaces_with_blocks``. Grids are drawn as their outer boundary,
+    coloured by their property ``property`` (cell or point) where they have it; wells as
+    their trajectory with their markers."""
+    pairs = drawn_meshes(scene, blocks) + drawn_grids_and_wells(scene, property)
     if not pairs:
-        raise OptionsError("nothing to show: the scene has no surfaces, lines, points or blocks")
+        raise OptionsError(
+            "nothing to show: the scene has no surfaces, lines, points, blocks, grids or wells"
+        )
+    if property is not None and not any(
+        property in g.cell_data or property in g.point_data
+        for g, s in pairs
+        if isinstance(s, RegularGrid | StructuredGrid)
+    ):
+        raise OptionsError(f"property: no grid of the scene has a property {property!r}")
     lows = np.min([np.asarray(g.vertices).min(axis=0) for g, _ in pairs], axis=0)  # type: ignore[attr-defined]
     highs = np.max([np.asarray(g.vertices).max(axis=0) for g, _ in pairs], axis=0)  # type: ignore[attr-defined]
     origin = np.round((lows + highs) / 2)

@@ -17,6 +17,8 @@
       title: model.title,
       crs: model.crs,
       objects: model.objects.map((o) => o.name),
+      types: model.objects.map((o) => o.type),
+      markers: model.objects.filter((o) => o.markers).reduce((n, o) => n + o.markers.names.length, 0),
       triangles: model.objects.reduce((n, o) => n + (o.mode === 4 ? o.count / 3 : 0), 0),
     }, extra));
     document.getElementById("geobrep-report").textContent = line;
@@ -60,14 +62,31 @@
     let item;
     if (object.mode === 4) {
       geometry.computeVertexNormals();
+      const shaded = Boolean(object.colours);  // a grid coloured by a property
+      if (shaded) {
+        geometry.setAttribute("color", new T.BufferAttribute(decode(object.colours, Uint8Array), 3, true));
+      }
       item = new T.Mesh(geometry, new T.MeshLambertMaterial({
-        color: colour, side: T.DoubleSide, clippingPlanes: clipping,
-        polygonOffset: object.type === "Block", polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+        color: shaded ? 0xffffff : colour, vertexColors: shaded, side: T.DoubleSide, clippingPlanes: clipping,
+        polygonOffset: object.type !== "Surface", polygonOffsetFactor: 1, polygonOffsetUnits: 1,
       }));
     } else if (object.mode === 1) {
       item = new T.LineSegments(geometry, new T.LineBasicMaterial({ color: colour, clippingPlanes: clipping }));
     } else {
       item = new T.Points(geometry, new T.PointsMaterial({ color: colour, size: 4, sizeAttenuation: false, clippingPlanes: clipping }));
+    }
+    if (object.markers) {  // a well's markers: points and their names, switched with the well
+      const trace = item;
+      item = new T.Group();
+      item.add(trace);
+      const picks = new T.BufferGeometry();
+      const at = decode(object.markers.positions, Float32Array);
+      picks.setAttribute("position", new T.BufferAttribute(at, 3));
+      item.add(new T.Points(picks, new T.PointsMaterial({ color: colour, size: 9, sizeAttenuation: false, clippingPlanes: clipping })));
+      object.markers.names.forEach((name, i) => {
+        const where = new T.Vector3(at[3 * i], at[3 * i + 1], at[3 * i + 2]);
+        label(name, where.add(new T.Vector3(radius * 0.02, 0, 0)), radius * 0.04, item);
+      });
     }
     item.name = object.name;
     item.visible = object.visible;
@@ -77,7 +96,10 @@
 
   // the list: one row per object, grouped by type, with its colour and a switch
   const list = document.getElementById("objects");
-  const headings = { Block: "Blocks", Surface: "Surfaces", PolyLine: "Lines", PointSet: "Points" };
+  const headings = {
+    Block: "Blocks", Surface: "Surfaces", PolyLine: "Lines", PointSet: "Points",
+    RegularGrid: "Regular grids", StructuredGrid: "Structured grids", Well: "Wells",
+  };
   Object.keys(headings).forEach((type) => {
     const members = model.objects.map((o, i) => [o, i]).filter(([o]) => o.type === type);
     if (!members.length) return;
@@ -133,7 +155,7 @@
     new T.LineBasicMaterial({ color: 0x555555 }));
   boxLines.position.copy(centre);
   scene.add(boxLines);
-  function label(text, position, height) {
+  function label(text, position, height, parent) {
     const canvas2d = document.createElement("canvas");
     const context = canvas2d.getContext("2d");
     context.font = "48px sans-serif";
@@ -146,7 +168,8 @@
     const sprite = new T.Sprite(new T.SpriteMaterial({ map: new T.CanvasTexture(canvas2d), depthTest: false }));
     sprite.scale.set(height * width / 64, height, 1);
     sprite.position.copy(position);
-    scene.add(sprite);
+    (parent || scene).add(sprite);
+    return sprite;
   }
   function niceStep(span) {
     const raw = span / 4;

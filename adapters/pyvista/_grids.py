@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from geobrep.adapters._grid_boundary import active_cells
 from geobrep.adapters.pyvista._convert import import_pyvista
 from geobrep.model.entities import Entity, RegularGrid, StructuredGrid, Well
 from geobrep.model.properties import PropertyMap
@@ -32,14 +33,6 @@ def _arrays(target: Any, props: PropertyMap) -> None:
     for name, prop in props.items():
         if prop.values.dtype.kind in "biuf":
             target[name] = np.asarray(prop.values)
-
-
-def _active(grid: RegularGrid | StructuredGrid) -> np.ndarray | None:
-    if isinstance(grid, StructuredGrid) and grid.actnum is not None:
-        return np.asarray(grid.actnum, dtype=bool)
-    if "active" in grid.cell_data and grid.cell_data["active"].values.ndim == 1:
-        return np.asarray(np.asarray(grid.cell_data["active"].values) != 0, dtype=bool)
-    return None
 
 
 def grid_to_pyvista(grid: RegularGrid | StructuredGrid) -> Any:
@@ -61,7 +54,7 @@ def grid_to_pyvista(grid: RegularGrid | StructuredGrid) -> Any:
         dataset.dimensions = (ni + 1, nj + 1, nk + 1)
         _arrays(dataset.point_data, grid.point_data)
     _arrays(dataset.cell_data, grid.cell_data)
-    active = _active(grid)
+    active = active_cells(grid)
     if active is not None and not active.all():
         dataset = dataset.extract_cells(np.flatnonzero(active))
     dataset.set_active_scalars(None)

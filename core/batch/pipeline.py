@@ -663,8 +663,8 @@ class RenderStep(OutputStep):
 
 class ViewStep(OutputStep):
     """Write the scene as one offline HTML page to look at in a browser (the ``html`` format:
-    three.js inlined, blocks and surfaces switchable, a clipping plane, axes in world
-    coordinates), as ``geobrep view`` does; ``name`` defaults to ``{stem}.html``. The scene
+    three.js inlined, blocks, surfaces, grids and wells switchable, a clipping plane, axes in
+    world coordinates), as ``geobrep view`` does; ``name`` defaults to ``{stem}.html``. The scene
     flows on unchanged."""
 
     kind: ClassVar[str] = "view"
@@ -678,6 +678,8 @@ class ViewStep(OutputStep):
     """do not show blocks (only surfaces, lines, points)"""
     all_surfaces: bool = False
     """with blocks, start with every surface shown too (default: only faults)"""
+    property: str | None = None
+    """colour the grids by this cell or point property"""
 
     def writer_options(self) -> dict[str, Any]:
         """The options of the ``html`` writer these options give."""
@@ -685,6 +687,7 @@ class ViewStep(OutputStep):
             "title": self.title,
             "blocks": self.blocks,
             "surfaces_with_blocks": self.all_surfaces,
+            "property": self.property,
         }
 
 

@@ -144,3 +144,34 @@ def test_names_are_escaped(tmp_path: Path) -> None:
     text = page.read_text()
     assert text.count("</script>") == 3  # the model's, three.js's and the viewer's
     assert "<\\/script><b>H1<\\/b>" in text
+
+
+def test_grids_and_wells_are_drawn_and_listed(tmp_path: Path) -> None:
+    from grid_shapes import build_well, faulted, rotated_grid
+
+    from geobrep.adapters._grid_boundary import grid_boundary
+
+    grid, corner_point, well = rotated_grid(), faulted(), build_well()
+    shift = grid.origin - well.head + np.array([60.0, 40.0, 800.0])  # beside the grid
+    well = well.replace(head=well.head + shift, vertices=well.vertices + shift)
+    moved = corner_point.coord + np.r_[grid.origin, grid.origin] + np.r_[0, -30, 0, 0, -30, 0]
+    corner_point = corner_point.replace(coord=moved, zcorn=corner_point.zcorn + grid.origin[2])
+    scene = geobrep.Scene(entities=[grid, corner_point, well], name="grids")
+    page = tmp_path / "grids.html"
+    model = geobrep.write(scene, tmp_path / "grids.geobrep")
+    assert main(["view", str(model), "-o", str(page), "--property", "por"]) == 0
+    report = _open(page, tmp_path / "grids.png", tmp_path)
+    assert report["webgl"] is True
+    assert report["objects"] == ["g", "cp", "W1"]
+    assert report["types"] == ["RegularGrid", "StructuredGrid", "Well"]
+    assert report["markers"] == len(well.markers) == 2
+    assert (
+        report["triangles"]
+        == grid_boundary(grid, "por").n_faces + grid_boundary(corner_point).n_faces
+    )
+    text = page.read_text()
+    assert '"names": ["topA", "topB"]' in text
+    pixels = _pixels(tmp_path / "grids.png")
+    assert len(np.unique(pixels.reshape(-1, 3), axis=0)) > 200  # not blank: a ramp of colours
+    with pytest.raises(OptionsError, match="no grid of the scene has a property 'nothing'"):
+        write(scene, tmp_path / "bad.html", property="nothing")
