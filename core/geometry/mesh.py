@@ -14,7 +14,13 @@ from numpy.typing import ArrayLike
 from geobrep.errors import DegenerateGeometryError, EntityValidationError
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.geometry.bbox import column_extremes
-from geobrep.geometry.graph import cell_hash, close_pairs, component_roots, equal_rows
+from geobrep.geometry.graph import (
+    cell_hash,
+    close_pairs,
+    component_roots,
+    equal_rows,
+    hashed_order,
+)
 from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
 
 __all__ = [
@@ -441,10 +447,9 @@ def _merge_candidates(local: FloatArray, tol: float) -> IntArray:
     scaled = np.floor(shifted / cell)
     offsets = shifted - scaled * cell
     margin = 2.0 * tol + 8.0 * np.finfo(np.float64).eps * reach
-    near_face = ((offsets <= margin) | (offsets >= cell - margin)).any(axis=1)
-    keys = cell_hash(scaled.astype(np.int64))
-    order = np.argsort(keys)
-    sorted_keys = keys[order]
+    face = (offsets <= margin) | (offsets >= cell - margin)
+    near_face = face[:, 0] | face[:, 1] | face[:, 2]  # column operations: faster than any()
+    order, sorted_keys = hashed_order(cell_hash(scaled.astype(np.int64)))
     same = sorted_keys[1:] == sorted_keys[:-1]
     crowded = np.zeros(n, dtype=np.bool_)
     crowded[order[1:][same]] = True
@@ -504,16 +509,19 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
         _, first, labels = np.unique(verts + 0.0, axis=0, return_index=True, return_inverse=True)
         labels = labels.reshape(-1)
     else:
-        # equal vertices first (one sort), then close pairs among the distinct ones
-        same = equal_rows(verts)
-        distinct = np.flatnonzero(same == np.arange(n))
+        # One sort of coarse cubes finds the vertices that may merge (every copy of a vertex
+        # shares its cube, so duplicates are among them); equal ones are welded first, then
+        # close pairs are searched among the distinct ones.
         centre = 0.5 * np.add(*column_extremes(verts))
-        local = np.take(verts, distinct, axis=0) - centre
+        local = verts - centre
         candidates = _merge_candidates(local, tol)
-        found = _close_pairs(np.take(local, candidates, axis=0), tol)
-        pairs = np.take(distinct, np.take(candidates, found))
-        a = np.concatenate([np.arange(n, dtype=np.int64), pairs[:, 0]])
-        b = np.concatenate([same, pairs[:, 1]])
+        same = np.take(candidates, equal_rows(np.take(verts, candidates, axis=0)))
+        distinct = np.take(candidates, np.flatnonzero(same == candidates))
+        found = _close_pairs(np.take(local, distinct, axis=0), tol)
+        pairs = np.take(distinct, found)
+        moved = np.flatnonzero(same != candidates)
+        a = np.concatenate([np.take(candidates, moved), pairs[:, 0]])
+        b = np.concatenate([np.take(same, moved), pairs[:, 1]])
         roots = component_roots(n, a, b)
         first, labels = compact_indices(roots, n)  # the lowest index of each group
     # first[g] is the lowest index of group g; renumber groups by that index.
