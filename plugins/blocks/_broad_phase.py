@@ -48,7 +48,13 @@ _OFFSETS = np.array([[(c >> 2) & 1, (c >> 1) & 1, c & 1] for c in range(8)], dty
 def _boxes(corners: FloatArray, margin: float) -> tuple[FloatArray, FloatArray]:
     """Boxes of triangles stored component-major, (corner, xyz, K): mins and maxs (xyz, K)."""
     a, b, c = corners[0], corners[1], corners[2]
-    return np.minimum(np.minimum(a, b), c) - margin, np.maximum(np.maximum(a, b), c) + margin
+    low, high = np.minimum(a, b), np.maximum(a, b)
+    np.minimum(low, c, out=low)
+    np.maximum(high, c, out=high)
+    if margin:
+        low -= margin
+        high += margin
+    return low, high
 
 
 def _dilated(values: NDArray[Any], op: Callable[..., object]) -> NDArray[Any]:
@@ -89,23 +95,39 @@ class _Grid:
 
     def ranges(self, mins: FloatArray, maxs: FloatArray) -> tuple[IntArray, IntArray]:
         """First cell (xyz, K) of each box and how many cells past it the box reaches."""
-        lo = np.floor((mins - self.origin) / self.size).astype(np.int64)
-        hi = np.floor((maxs - self.origin) / self.size).astype(np.int64)
-        np.maximum(lo, 0, out=lo)
-        np.minimum(hi, self.dims[:, None] - 1, out=hi)
-        hi -= lo
-        return lo, hi
+        # Offsets from the origin are not negative for the boxes the grid was made over, so a
+        # truncating cast floors them; x · (1 / size) is monotone in x like x / size, so boxes
+        # that overlap still share a cell (and the cell geometry of :meth:`touches` allows for
+        # the rounding).
+        scale = 1.0 / self.size
+        lo = mins - self.origin
+        lo *= scale
+        np.maximum(lo, 0.0, out=lo)
+        hi = maxs - self.origin
+        hi *= scale
+        np.maximum(hi, 0.0, out=hi)
+        first, last = lo.astype(np.int64), hi.astype(np.int64)
+        np.minimum(first, self.dims[:, None] - 1, out=first)
+        np.minimum(last, self.dims[:, None] - 1, out=last)
+        last -= first
+        return first, last
 
     def cells(self, first: IntArray, past: IntArray) -> tuple[IntArray, IntArray, IntArray]:
         """Rows (box, cell key, offset code) of every cell of each box's range."""
         sizes = past + 1
-        counts = sizes[0] * sizes[1] * sizes[2]
-        box = np.repeat(np.arange(counts.shape[0], dtype=np.int64), counts)
-        k = concatenated_ranges(np.zeros(counts.shape[0], np.int64), counts)
-        dx, rest = np.divmod(k, np.repeat(sizes[1] * sizes[2], counts))
-        dy, dz = np.divmod(rest, np.repeat(sizes[2], counts))
-        key = (self.strides @ first)[box] + dx * self.strides[0] + dy * self.strides[1] + dz
-        code = 4 * (dx > 0) + 2 * (dy > 0) + (dz > 0).astype(np.int64)
+        box = np.arange(sizes.shape[1], dtype=np.int64)
+        key = self.strides @ first
+        code = np.zeros(box.shape[0], dtype=np.int64)
+        # One axis at a time (x, then y, then z: rows by box, then dx, dy, dz): each row is
+        # repeated as many times as the box spans cells along the axis, without divisions.
+        for axis, bit in ((0, 4), (1, 2), (2, 1)):
+            count = np.take(sizes[axis], box)
+            if int(count.max(initial=1)) == 1:
+                continue
+            step = concatenated_ranges(np.zeros(count.shape[0], np.int64), count)
+            box, key, code = np.repeat(box, count), np.repeat(key, count), np.repeat(code, count)
+            key += step * self.strides[axis]
+            code |= (step > 0) * bit
         return box, key, code
 
     def touches(self, corners: FloatArray, key: IntArray, margin: float) -> BoolArray:
