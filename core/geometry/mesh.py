@@ -427,14 +427,16 @@ def is_consistently_oriented(faces: ArrayLike) -> bool:
 
 
 # --------------------------------------------------------------------------- vertices
-def _merge_candidates(local: FloatArray, tol: float) -> IntArray:
-    """Vertices that may lie within ``tol`` of another one (a superset; pairs are checked after).
+def _merge_candidates(local: FloatArray, tol: float) -> tuple[IntArray, BoolArray, IntArray]:
+    """Vertices that may lie within ``tol`` of another one (a superset; pairs are checked
+    after), with whether each lies near a face of its cube and its cube's hash.
 
     Vertices are binned in cubes of side about ``1000 · tol`` (a hash of the cube numbers, so
     any extent works): two vertices within ``tol`` of each other share a cube or both lie
     within ``tol`` of a cube face, so only vertices in crowded cubes or near a face need the
     exact search — a small share of distinct vertices whose spacing exceeds the tolerance.
-    Falls back to every vertex when the cubes are too fine for the coordinates.
+    Falls back to every vertex (all near a face) when the cubes are too fine for the
+    coordinates.
     """
     n = local.shape[0]
     everything = np.arange(n, dtype=np.int64)
@@ -442,7 +444,7 @@ def _merge_candidates(local: FloatArray, tol: float) -> IntArray:
     cell = 1021.37 * tol
     reach = float(np.abs(local).max()) if n else 0.0
     if cell <= 1e-9 * reach or reach / cell > 2.0**60:
-        return everything
+        return everything, np.ones(n, dtype=np.bool_), np.zeros(n, dtype=np.int64)
     shifted = local + 0.3819 * cell
     scaled = np.floor(shifted / cell)
     offsets = shifted - scaled * cell
@@ -454,7 +456,21 @@ def _merge_candidates(local: FloatArray, tol: float) -> IntArray:
     crowded = np.zeros(n, dtype=np.bool_)
     crowded[order[1:][same]] = True
     crowded[order[:-1][same]] = True
-    return np.flatnonzero(near_face | crowded).astype(np.int64)
+    candidates = np.flatnonzero(near_face | crowded).astype(np.int64)
+    cube = np.empty(n, dtype=np.int64)
+    cube[order] = sorted_keys
+    return candidates, near_face[candidates], cube[candidates]
+
+
+def _repeated(keys: IntArray) -> BoolArray:
+    """Whether each key occurs more than once."""
+    order = np.argsort(keys)
+    ordered = keys[order]
+    same = ordered[1:] == ordered[:-1]
+    repeated = np.zeros(keys.shape[0], dtype=np.bool_)
+    repeated[order[1:][same]] = True
+    repeated[order[:-1][same]] = True
+    return repeated
 
 
 def first_of_duplicates(cells: ArrayLike) -> BoolArray:
@@ -514,9 +530,13 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
         # close pairs are searched among the distinct ones.
         centre = 0.5 * np.add(*column_extremes(verts))
         local = verts - centre
-        candidates = _merge_candidates(local, tol)
+        candidates, near_face, cube = _merge_candidates(local, tol)
         same = np.take(candidates, equal_rows(np.take(verts, candidates, axis=0)))
-        distinct = np.take(candidates, np.flatnonzero(same == candidates))
+        # Of the distinct vertices, those near a cube face or sharing their cube with another
+        # distinct one (not only with copies of themselves) are searched.
+        kept = np.flatnonzero(same == candidates)
+        search = near_face[kept] | _repeated(cube[kept])
+        distinct = np.take(candidates, kept[search])
         found = _close_pairs(np.take(local, distinct, axis=0), tol)
         pairs = np.take(distinct, found)
         moved = np.flatnonzero(same != candidates)
@@ -533,15 +553,47 @@ def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatAr
 
 
 def _close_pairs(points: FloatArray, tol: float) -> IntArray:
-    """Pairs of ``points`` within ``tol``: a hashed grid, or scipy's k-d tree (imported only
-    then) for a crowd of points so close together that the grid would be quadratic."""
-    pairs = close_pairs(points, tol)
+    """Pairs of ``points`` within ``tol``: a sweep along x for a few points, else a hashed
+    grid, or scipy's k-d tree (imported only then) for a crowd of points so close together
+    that the grid would be quadratic."""
+    pairs = _swept_pairs(points, tol) if points.shape[0] <= _SWEEP_POINTS else None
+    if pairs is None:
+        pairs = close_pairs(points, tol)
     if pairs is not None:
         return pairs
     from scipy.spatial import cKDTree
 
     found: IntArray = cKDTree(points).query_pairs(r=tol, output_type="ndarray")
     return found.astype(np.int64).reshape(-1, 2)
+
+
+#: Up to this many points, close pairs come from a sweep along x (a handful of whole-array
+#: passes) rather than the 14 cube lookups of the hashed grid; beyond this many candidates per
+#: point the sweep gives up.
+_SWEEP_POINTS = 20_000
+_SWEEP_PER_POINT = 8
+
+
+def _swept_pairs(points: FloatArray, tol: float) -> IntArray | None:
+    """Pairs ``(i, j)``, ``i < j``, of the points within ``tol`` (the grid's distance test on
+    every pair closer than ``2 · tol`` along x); None when the x slabs are crowded."""
+    n = points.shape[0]
+    order = np.argsort(points[:, 0], kind="stable")
+    x = points[order, 0]
+    end = np.searchsorted(x, x + 2.0 * tol, side="right")
+    count = end - np.arange(1, n + 1, dtype=np.int64)
+    total = int(count.sum())
+    if total > _SWEEP_PER_POINT * n + 64:
+        return None
+    first = np.repeat(np.arange(n, dtype=np.int64), count)
+    second = (
+        first + 1 + np.arange(total, dtype=np.int64) - np.repeat(np.cumsum(count) - count, count)
+    )
+    i, j = order[first], order[second]
+    d = points[i] - points[j]
+    close = np.einsum("ij,ij->i", d, d) <= tol * tol
+    i, j = i[close], j[close]
+    return np.stack([np.minimum(i, j), np.maximum(i, j)], axis=1).astype(np.int64)
 
 
 def part_vertices(faces: ArrayLike, labels: ArrayLike | None, n_vertices: int) -> list[IntArray]:

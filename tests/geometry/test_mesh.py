@@ -420,6 +420,31 @@ def test_merge_close_vertices_matches_brute_force(
     assert inverse.dtype == np.int64
 
 
+@pytest.mark.parametrize(("n", "tolerance"), [(500, 1e-2), (30_000, 1e-2), (30_000, 0.1)])
+def test_merge_close_vertices_matches_a_kd_tree(n: int, tolerance: float) -> None:
+    """Scattered points with exact copies, close pairs and chains (few candidates: the sweep;
+    at 0.1 every cube is crowded and 36,000 go to the hashed grid): the groups of a k-d
+    tree's pairs within tolerance."""
+    from scipy.sparse import coo_matrix
+    from scipy.spatial import cKDTree
+
+    rng = np.random.default_rng(n)
+    base = rng.random((n, 3)) * [2000.0, 1500.0, 300.0] + [450_000.0, 6_700_000.0, 0.0]
+    copies = base[rng.integers(0, n, n // 5)]
+    near = base[rng.integers(0, n, n // 5)] + rng.normal(0.0, 4e-3, (n // 5, 3))
+    chain = base[:1] + np.arange(1, 6)[:, None] * [9e-3, 0.0, 0.0]
+    vertices = rng.permutation(np.concatenate([base, copies, near, chain]))
+    unique, inverse = merge_close_vertices(vertices, tolerance)
+    pairs = cKDTree(vertices).query_pairs(tolerance, output_type="ndarray")
+    m = vertices.shape[0]
+    graph = coo_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(m, m))
+    _, labels = connected_components(graph, directed=False)
+    _, first, ref_inverse = np.unique(labels, return_index=True, return_inverse=True)
+    rank = np.argsort(np.argsort(first))
+    np.testing.assert_array_equal(inverse, rank[ref_inverse])
+    np.testing.assert_array_equal(unique, vertices[np.sort(first)])
+
+
 def test_merge_close_vertices_known_answer() -> None:
     vertices = np.array(
         [[5, 0, 0], [0, 0, 0], [5, 0, 1e-4], [0, 0, -0.0], [0, 0, 2e-4], [9, 9, 9], [0, 0, 1e-4]]
