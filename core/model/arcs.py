@@ -26,9 +26,9 @@ reading a Model3d, rebuilding its blocks from the bare surfaces and reading it b
 writing all agree.
 
 The computation is vectorised: edge–triangle incidence, multiset signatures per arc edge (one
-``np.unique`` over a padded table), corner tests per vertex, and one depth-first walk over the
-graph of arc edges continuing each other (list ranking, :func:`geobrep.geometry.graph.path_order`)
-that lists every chain in order.
+sort of (edge, patch) keys, each edge's patches packed as the digits of one integer), corner
+tests per vertex, and one depth-first walk over the graph of arc edges continuing each other
+(list ranking, :func:`geobrep.geometry.graph.path_order`) that lists every chain in order.
 
 >>> import geobrep
 >>> scene = geobrep.datasets.faulted_layer_cake()
@@ -123,11 +123,40 @@ def _multiset_signatures(
         np.cumsum(counts) - counts, counts
     )
     patches = incident_patch[positions]
+    width = int(counts.max())
+    highest = int(patches.max(initial=0))
+    bits = max(highest.bit_length(), 1)  # a patch
+    digit_bits = (highest + 1).bit_length()  # a patch + 1 (0: an empty slot)
+    packable = width * digit_bits <= 62 and bits + max(arc_edges.shape[0], 1).bit_length() <= 62
+    if packable and int(patches.min(initial=0)) >= 0:
+        # Rows ascend already: one sort of (row, patch) keys sorts each row's patches in
+        # place, and a row's sorted patches packed as digits of one integer name its multiset.
+        ordered = np.sort(rows << bits | patches)
+        digit = (ordered & ((1 << bits) - 1)) + 1
+        key = np.zeros(arc_edges.shape[0], dtype=np.int64)
+        for slot in range(width):
+            used = np.flatnonzero(within == slot)
+            key[rows[used]] += digit[used] << (digit_bits * slot)
+        return _dense_labels(key)
     order = np.lexsort((patches, rows))
-    table = np.full((arc_edges.shape[0], int(counts.max())), -1, dtype=np.int64)
+    table = np.full((arc_edges.shape[0], width), -1, dtype=np.int64)
     table[rows, within] = patches[order]
     _, signature = np.unique(table, axis=0, return_inverse=True)
     return signature.reshape(-1).astype(np.int64)
+
+
+def _sorted_unique(values: IntArray) -> IntArray:
+    """``np.unique`` of integers by one sort (numpy's hashing ``unique`` is many times slower)."""
+    ordered = np.sort(values.reshape(-1))
+    keep = np.ones(ordered.shape[0], dtype=np.bool_)
+    keep[1:] = ordered[1:] != ordered[:-1]
+    return ordered[keep]
+
+
+def _dense_labels(keys: IntArray) -> IntArray:
+    """Labels ``0 … k-1`` of the distinct ``keys`` (equal keys, equal labels), ascending."""
+    distinct = _sorted_unique(keys)
+    return np.searchsorted(distinct, keys).astype(np.int64)
 
 
 def _touch_corners(
@@ -150,7 +179,7 @@ def _touch_corners(
         vertex = edges[near[rows], column]
         keep = on_arc[vertex]
         keys.append(vertex[keep] * n_patches + patch[keep])
-    pairs = np.unique(np.concatenate(keys))
+    pairs = _sorted_unique(np.concatenate(keys))
     vertex, member = pairs // n_patches, pairs % n_patches
     with np.errstate(over="ignore"):
         key = member.astype(np.uint64) + np.uint64(1)

@@ -365,7 +365,9 @@ def _shared_edges(soup: Soup, rows: IntArray, other_surface: IntArray) -> BoolAr
     tri = soup.triangles
     low = np.minimum(tri, tri[:, _NEXT]).reshape(-1)
     high = np.maximum(tri, tri[:, _NEXT]).reshape(-1)
-    known = np.unique((low * n_vertices + high) * n_surfaces + np.repeat(soup.triangle_surface, 3))
+    known = _sorted_unique(
+        (low * n_vertices + high) * n_surfaces + np.repeat(soup.triangle_surface, 3)
+    )
     mine = tri[rows]
     edge = np.minimum(mine, mine[:, _NEXT]) * n_vertices + np.maximum(mine, mine[:, _NEXT])
     key = edge * n_surfaces + other_surface[:, None]
@@ -465,12 +467,14 @@ def _allowed_surfaces(soup: Soup, border: IntArray) -> IntArray:
     wanted[ring_other] = True
     corner_vertex = soup.triangles.reshape(-1)
     keep = wanted[corner_vertex]
-    held = np.unique(corner_vertex[keep] * n_surfaces + np.repeat(soup.triangle_surface, 3)[keep])
+    held = _sorted_unique(
+        corner_vertex[keep] * n_surfaces + np.repeat(soup.triangle_surface, 3)[keep]
+    )
     held_vertex, held_surface = held // n_surfaces, held % n_surfaces
     start = np.searchsorted(held_vertex, ring_other, side="left")
     count = np.searchsorted(held_vertex, ring_other, side="right") - start
     rows = concatenated_ranges(start, count)
-    return np.unique(np.repeat(ring_vertex, count) * n_surfaces + held_surface[rows])
+    return _sorted_unique(np.repeat(ring_vertex, count) * n_surfaces + held_surface[rows])
 
 
 def _boxes_within(
