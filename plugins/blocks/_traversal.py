@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from geobrep.geometry.arrays import IntArray
+from geobrep.plugins.blocks._csr import components
 from geobrep.plugins.blocks._orientation import DirectionTriangles
 
 __all__ = ["Regions", "side_node", "traverse"]
@@ -48,9 +49,6 @@ def traverse(around: DirectionTriangles, n_patches: int) -> Regions:
     >>> int(r.positive[0]) == int(r.negative[0])
     True
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     rows = np.arange(around.patch.shape[0], dtype=np.int64)
     following = rows + 1
     ends = around.offsets[1:] - 1
@@ -58,12 +56,7 @@ def traverse(around: DirectionTriangles, n_patches: int) -> Regions:
     sense = np.where(around.forward, 1, -1).astype(np.int64)
     here = side_node(around.patch, sense)  # the side facing the next patch
     there = side_node(around.patch[following], -sense[following])  # its side facing back
-    n_nodes = 2 * n_patches
-    graph = coo_matrix(
-        (np.ones(here.shape[0], dtype=np.int8), (here, there)), shape=(n_nodes, n_nodes)
-    )
-    n_regions, labels = connected_components(graph, directed=False)
-    labels = labels.astype(np.int64)
+    n_regions, labels = components(2 * n_patches, here, there)
     return Regions(
         positive=labels[0::2],
         negative=labels[1::2],

@@ -19,7 +19,7 @@ import numpy as np
 
 from geobrep.geometry.arrays import FloatArray, IntArray
 from geobrep.geometry.bbox import column_extremes
-from geobrep.plugins.blocks._csr import group_sums
+from geobrep.plugins.blocks._csr import components, group_sums
 from geobrep.plugins.blocks._measures import PatchMeasures
 from geobrep.plugins.blocks._patches import PatchSplit
 from geobrep.plugins.blocks._soup import Soup
@@ -93,17 +93,13 @@ def find_universe(
     soup: Soup, split: PatchSplit, regions: Regions, measures: PatchMeasures
 ) -> Bodies:
     """Merge the regions into bodies and pick the universe (see the module docstring)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     n_patches, n_regions = split.n_patches, regions.n_regions
     shares = measures.volume
     volume = group_sums(regions.positive, -shares, n_regions) + group_sums(
         regions.negative, shares, n_regions
     )
     a, b = regions.link_patches
-    graph = coo_matrix((np.ones(a.shape[0], np.int8), (a, b)), shape=(n_patches, n_patches))
-    n_components, component = connected_components(graph, directed=False)
+    n_components, component = components(n_patches, a, b)
     region_component = np.empty(n_regions, dtype=np.int64)
     region_component[regions.positive] = component
     region_component[regions.negative] = component
