@@ -58,14 +58,20 @@ def _boxes(corners: FloatArray, margin: float) -> tuple[FloatArray, FloatArray]:
 
 
 def _dilated(values: NDArray[Any], op: Callable[..., object]) -> NDArray[Any]:
-    """``op`` (``np.minimum`` or ``np.maximum``) over the 3 x 3 x 3 cells around each cell."""
+    """``op`` (``np.minimum`` or ``np.maximum``) over the 3 x 3 x 3 cells around each cell.
+
+    One axis at a time, in the array's own memory order (slices along the axis, no transposed
+    copies): each pass reads the values before it from a plain copy."""
+    out = np.array(values, order="C")
     for axis in range(3):
-        moved = np.moveaxis(values, axis, 0)
-        out = moved.copy()
-        op(out[1:], moved[:-1], out=out[1:])
-        op(out[:-1], moved[1:], out=out[:-1])
-        values = np.moveaxis(out, 0, axis)
-    return values
+        before = out.copy()
+
+        def part(start: int | None, stop: int | None, axis: int = axis) -> tuple[slice, ...]:
+            return tuple(slice(start, stop) if k == axis else slice(None) for k in range(3))
+
+        op(out[part(1, None)], before[part(None, -1)], out=out[part(1, None)])
+        op(out[part(None, -1)], before[part(1, None)], out=out[part(None, -1)])
+    return out
 
 
 class _Grid:
