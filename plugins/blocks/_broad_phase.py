@@ -40,6 +40,8 @@ _MAX_CELLS = 192
 _COARSE = 4
 #: Spread boxes reaching more cells than this many per box go through the blocks.
 _BLOCKS_OVER = 2
+#: Boxes converted to cells at a time.
+_SLICE = 32_768
 #: Cell offsets (x, y, z) of the eight cells a box reaching two cells per axis may reach; code c
 #: has bit 4 set when the cell lies past the box's first cell along x, 2 along y, 1 along z.
 _OFFSETS = np.array([[(c >> 2) & 1, (c >> 1) & 1, c & 1] for c in range(8)], dtype=np.int64).T
@@ -105,16 +107,19 @@ class _Grid:
         # truncating cast floors them; x · (1 / size) is monotone in x like x / size, so boxes
         # that overlap still share a cell (and the cell geometry of :meth:`touches` allows for
         # the rounding).
-        scale = 1.0 / self.size
-        lo = mins - self.origin
-        lo *= scale
-        np.maximum(lo, 0.0, out=lo)
-        hi = maxs - self.origin
-        hi *= scale
-        np.maximum(hi, 0.0, out=hi)
-        first, last = lo.astype(np.int64), hi.astype(np.int64)
-        np.minimum(first, self.dims[:, None] - 1, out=first)
-        np.minimum(last, self.dims[:, None] - 1, out=last)
+        # In slices whose temporaries stay in cache.
+        scale, top = 1.0 / self.size, self.dims[:, None] - 1
+        n = mins.shape[1]
+        first, last = np.empty((3, n), dtype=np.int64), np.empty((3, n), dtype=np.int64)
+        for start in range(0, n, _SLICE):
+            rows = slice(start, start + _SLICE)
+            for bound, cells in ((mins, first), (maxs, last)):
+                offset = bound[:, rows] - self.origin
+                offset *= scale
+                np.maximum(offset, 0.0, out=offset)
+                part = offset.astype(np.int64)
+                np.minimum(part, top, out=part)
+                cells[:, rows] = part
         last -= first
         return first, last
 
