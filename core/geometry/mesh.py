@@ -390,10 +390,55 @@ def edge_face_incidence(faces: ArrayLike) -> tuple[IntArray, IntArray, IntArray,
     ([0, 1], [1, 0])
     """
     f = _as_faces(faces, "edge_face_incidence")
-    k = f.shape[1]
+    m, k = f.shape
+    vertex_bits = max(int(f.max(initial=0)).bit_length(), 1)
+    side_bits = max((m * k - 1).bit_length(), 1)
+    if m and 2 * vertex_bits + side_bits <= 63:
+        return _incidence_by_bits(f, vertex_bits, side_bits)
     edges, offsets, perm, _ = _edge_groups(f)
     face = perm // k
     return edges, offsets, face, perm - face * k
+
+
+#: Faces keyed at a time (temporaries that stay in cache).
+_KEY_ROWS = 32_768
+
+
+def _incidence_by_bits(
+    faces: IntArray, vertex_bits: int, side_bits: int
+) -> tuple[IntArray, IntArray, IntArray, IntArray]:
+    """:func:`edge_face_incidence` from one in-place sort of the sides packed as bit fields
+    (low vertex, high vertex, side position), keyed in cache-sized slices of faces: the order
+    of ``(edge key, position)`` that :func:`_stable_sort` gives, without its copies."""
+    m, k = faces.shape
+    following = [*range(1, k), 0]
+    packed = np.empty((m, k), dtype=np.int64)
+    for start in range(0, m, _KEY_ROWS):
+        rows = slice(start, start + _KEY_ROWS)
+        first = faces[rows]
+        low = first[:, following]  # a new array: the side ends, then the low ends
+        high = np.maximum(first, low)
+        np.minimum(first, low, out=low)
+        low <<= vertex_bits
+        low |= high
+        low <<= side_bits
+        packed[rows] = low
+    flat = packed.reshape(-1)
+    flat |= np.arange(m * k, dtype=np.int64)
+    flat.sort()
+    mask = (1 << side_bits) - 1
+    position = flat & mask
+    flat >>= side_bits  # the edge keys, ascending
+    starts_mask = np.ones(flat.shape[0], dtype=np.bool_)
+    np.not_equal(flat[1:], flat[:-1], out=starts_mask[1:])
+    starts = np.flatnonzero(starts_mask)
+    unique_keys = np.take(flat, starts)
+    edges = np.empty((starts.shape[0], 2), dtype=np.int64)
+    np.right_shift(unique_keys, vertex_bits, out=edges[:, 0])
+    np.bitwise_and(unique_keys, (1 << vertex_bits) - 1, out=edges[:, 1])
+    offsets = np.append(starts, flat.shape[0]).astype(np.int64, copy=False)
+    face = position // k
+    return edges, offsets, face, position - face * k
 
 
 def is_closed(faces: ArrayLike) -> bool:
