@@ -217,6 +217,26 @@ def test_edge_face_incidence_csr() -> None:
     np.testing.assert_array_equal(face_edges[incident, sides], edge_of_entry)
 
 
+@pytest.mark.parametrize(("m", "k"), [(70_000, 3), (9_000, 4)])
+def test_edge_face_incidence_matches_a_sorted_list(m: int, k: int) -> None:
+    """Random faces (triangles across several key slices, quads): edges ascending, each with
+    its (face, side) entries ascending, as a plain sort of the sides lists them."""
+    faces = np.random.default_rng(m).integers(0, 5_000, (m, k))
+    edges, offsets, incident, sides = edge_face_incidence(faces)
+    ends = np.stack([faces, np.roll(faces, -1, axis=1)], axis=2)
+    rows = sorted(
+        (min(a, b), max(a, b), f, j)
+        for f, face in enumerate(ends.tolist())
+        for j, (a, b) in enumerate(face)
+    )
+    expected = np.array(rows, dtype=np.int64)
+    edge_of_entry = np.repeat(np.arange(edges.shape[0]), np.diff(offsets))
+    np.testing.assert_array_equal(edges[edge_of_entry], expected[:, :2])
+    np.testing.assert_array_equal(incident, expected[:, 2])
+    np.testing.assert_array_equal(sides, expected[:, 3])
+    assert np.all(np.diff(offsets) > 0)
+
+
 def test_empty_mesh() -> None:
     vertices = np.zeros((0, 3))
     for faces in (np.zeros((0, 3), dtype=np.int64), np.zeros((0, 4), dtype=np.int32)):
