@@ -105,5 +105,10 @@ def fingerprints() -> dict[str, Any]:
 
 if __name__ == "__main__":
     EXPECTED.parent.mkdir(exist_ok=True)
-    EXPECTED.write_text(json.dumps(fingerprints(), indent=1, sort_keys=True) + "\n")
+    found = fingerprints()
+    lines = [
+        f" {json.dumps(k)}: {json.dumps(found[k], sort_keys=True, separators=(',', ':'))}"
+        for k in sorted(found)
+    ]
+    EXPECTED.write_text("{\n" + ",\n".join(lines) + "\n}\n")
     print(f"wrote {EXPECTED}")
