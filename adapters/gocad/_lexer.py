@@ -8,8 +8,10 @@ parse (:func:`parse_run`) and walks only the few remaining lines in Python.
 
 from __future__ import annotations
 
+import bisect
 import contextlib
 import importlib
+import itertools
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,10 +23,25 @@ from numpy.typing import NDArray
 
 from geobrep.errors import FormatError
 
-__all__ = ["BULK_KEYWORDS", "ORJSON", "Line", "Run", "Source", "parse_run", "scan", "split_tokens"]
+__all__ = [
+    "BULK_KEYWORDS",
+    "KEYWORDS",
+    "ORJSON",
+    "Line",
+    "Run",
+    "Source",
+    "keyword_codes",
+    "parse_rows",
+    "parse_run",
+    "scan",
+    "split_tokens",
+]
 
 #: Keywords whose lines are parsed in bulk (the keyword, then numbers).
 BULK_KEYWORDS: tuple[str, ...] = ("VRTX", "PVRTX", "TRGL", "SEG", "TETRA", "ATOM", "PATOM")
+#: Every keyword :func:`keyword_codes` recognises: the bulk ones, then the id lines of a
+#: TSurf's borders (read in bulk by a whole body, see ``_bodies``; never a :class:`Run`).
+KEYWORDS: tuple[str, ...] = (*BULK_KEYWORDS, "BSTONE", "BORDER")
 
 
 @dataclass(frozen=True)
@@ -56,7 +73,8 @@ class Source:
     def __init__(self, path: Path, data: bytes) -> None:
         self.path = path
         buffer = np.frombuffer(data, dtype=np.uint8)
-        returns = np.flatnonzero(buffer == 13)
+        # most files have no CR at all: one memchr instead of a pass of numpy
+        returns = np.flatnonzero(buffer == 13) if b"\r" in data else np.zeros(0, np.int64)
         if returns.size:
             after = np.take(buffer, returns + 1, mode="clip")
             if returns[-1] == len(data) - 1 or (after != 10).any():  # lone CRs
@@ -76,6 +94,23 @@ class Source:
         """Every bulk run of the file (filled by :func:`scan`)."""
         self.batched: dict[int, NDArray[Any]] | None = None
         """Run first line -> its numbers, parsed together with the runs like it."""
+        self._codes: NDArray[np.int8] | None = None
+        self._pairs: list[tuple[int, int]] | None = None
+        self._others: list[int] | None = None
+
+    @property
+    def codes(self) -> NDArray[np.int8]:
+        """Per line: index + 1 of its keyword in :data:`KEYWORDS`, or 0 (computed once)."""
+        if self._codes is None:
+            self._codes = keyword_codes(self)
+        return self._codes
+
+    @property
+    def others(self) -> list[int]:
+        """0-based indices of the lines that start with none of :data:`KEYWORDS`."""
+        if self._others is None:
+            self._others = np.flatnonzero(self.codes == 0).tolist()
+        return self._others
 
     @classmethod
     def read(cls, path: Path) -> Source:
@@ -101,54 +136,81 @@ def decode(raw: bytes) -> str:
         return raw.decode("latin-1")
 
 
-def _keyword_codes(source: Source) -> NDArray[np.int8]:
-    """Per line: index + 1 of its bulk keyword in :data:`BULK_KEYWORDS`, or 0."""
-    width = 7
+def keyword_codes(source: Source) -> NDArray[np.int8]:
+    """Per line: index + 1 of the keyword of :data:`KEYWORDS` it starts with (followed by a
+    blank or a tab), or 0."""
+    width = 1 + max(map(len, KEYWORDS))
     buffer = np.frombuffer(source.data, dtype=np.uint8)
     # One gather per byte; past the end of the file the last byte repeats (a letter or a line
     # break, never the space or tab that must follow a keyword).
     columns = [np.take(buffer, source.starts + k, mode="clip") for k in range(width)]
+    # the first 4 bytes of each line as one integer: one comparison per keyword
+    head = columns[0].astype(np.uint32)
+    for k in range(1, 4):
+        head |= columns[k].astype(np.uint32) << np.uint32(8 * k)
     codes = np.zeros(source.n_lines, dtype=np.int8)
-    for index, keyword in enumerate(BULK_KEYWORDS, start=1):
-        match = np.ones(source.n_lines, dtype=bool)
-        for k, byte in enumerate(keyword.encode()):
-            match &= columns[k] == byte
-        follower = columns[len(keyword)]
-        match &= (follower == 32) | (follower == 9)
-        codes[match] = index
+    for index, keyword in enumerate(KEYWORDS, start=1):
+        raw = keyword.encode()
+        key = np.uint32(int.from_bytes(raw[:4], "little"))
+        if len(raw) < 4:  # SEG: its three bytes
+            mask = np.uint32((1 << (8 * len(raw))) - 1)
+            candidates = np.flatnonzero((head & mask) == key)
+        else:
+            candidates = np.flatnonzero(head == key)
+        if not candidates.size:
+            continue
+        keep = np.ones(candidates.shape[0], dtype=bool)
+        for k in range(4, len(raw)):
+            keep &= columns[k][candidates] == raw[k]
+        follower = columns[len(raw)][candidates]
+        keep &= (follower == 32) | (follower == 9)
+        codes[candidates[keep]] = index
     return codes
 
 
-def scan(source: Source) -> Iterator[Line | Run]:
-    """Yield the file's content in order: bulk :class:`Run` s and other :class:`Line` s.
+def _runs(source: Source) -> list[tuple[int, int]]:
+    """The file's stretches of lines ``[lo, hi)`` (0-based), each a bulk run or lines that
+    are none; fills :attr:`Source.runs` (computed once)."""
+    if source._pairs is not None:
+        return source._pairs
+    codes = source.codes.copy()
+    codes[codes > len(BULK_KEYWORDS)] = 0  # BSTONE, BORDER: lines of their own
+    n = codes.shape[0]
+    change = np.flatnonzero(codes[1:] != codes[:-1]) + 1
+    bounds = np.concatenate([[0], change, [n]]).tolist() if n else [0]
+    source._pairs = list(itertools.pairwise(bounds))
+    bulk = [(lo, hi) for lo, hi in source._pairs if codes[lo]]
+    starts = source.starts[[lo for lo, _ in bulk]].tolist()
+    ends = source.ends[[hi - 1 for _, hi in bulk]].tolist()
+    source.runs = [
+        Run(BULK_KEYWORDS[int(codes[lo]) - 1], lo + 1, hi - lo, start, end)
+        for (lo, hi), start, end in zip(bulk, starts, ends, strict=True)
+    ]
+    return source._pairs
+
+
+def _first(run: Run) -> int:
+    return run.first
+
+
+def scan(source: Source, start: int = 0) -> Iterator[Line | Run]:
+    """Yield the file's content in order: bulk :class:`Run` s and other :class:`Line` s,
+    from the 0-based line ``start`` on (a run ``start`` cuts is yielded whole).
 
     Blank lines are dropped; so are comment lines starting with ``#``, except ``# CTETRA``
     lines, which carry TSolid data.
     """
-    codes = _keyword_codes(source)
-    n = codes.shape[0]
-    if n == 0:
+    pairs = _runs(source)
+    codes = source.codes
+    first = max(bisect.bisect_right(pairs, (start, source.n_lines + 1)) - 1, 0)
+    if first >= len(pairs):
         return
-    change = np.flatnonzero(codes[1:] != codes[:-1]) + 1
-    bounds = np.concatenate([[0], change, [n]])
-    pairs = list(zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True))
-    source.runs = [
-        Run(
-            BULK_KEYWORDS[int(codes[lo]) - 1],
-            lo + 1,
-            hi - lo,
-            int(source.starts[lo]),
-            int(source.ends[hi - 1]),
-        )
-        for lo, hi in pairs
-        if codes[lo]
-    ]
-    runs = iter(source.runs)
-    for lo, hi in pairs:
-        if codes[lo]:
+    runs = iter(source.runs[bisect.bisect_left(source.runs, pairs[first][0] + 1, key=_first) :])
+    for lo, hi in pairs[first:]:
+        if 0 < codes[lo] <= len(BULK_KEYWORDS):
             yield next(runs)
             continue
-        for index in range(lo, hi):
+        for index in range(max(lo, start), hi):
             text = source.text(index).strip()
             if not text or (text.startswith("#") and not text.startswith("# CTETRA")):
                 continue
@@ -273,6 +335,43 @@ def parse_run(source: Source, run: Run, integer: bool) -> NDArray[Any]:
     return _parse_block(raw, 0, len(raw), starts, len(keyword), only_integers, none)
 
 
+def parse_rows(source: Source, runs: list[Run], integer: bool) -> NDArray[Any]:
+    """The numbers after the keyword of every line of ``runs`` (runs of one keyword, in file
+    order) as one 2-D array, as :func:`parse_run` reads each run (int64 when the runs hold
+    integers only, else float64; ``integer``: they must).
+
+    Raises :class:`BulkParseError` when the lines are not a rectangle of plain numbers (or
+    the speed-up library is missing): the caller then reads them the way it reads any run.
+    """
+    if ORJSON is None or not runs:
+        raise BulkParseError
+    keyword = runs[0].keyword.encode()
+    data = source.data
+    count = sum(run.count for run in runs)
+    if len(runs) == 1:
+        text, start, end = data, runs[0].start, runs[0].end
+    else:
+        text = b"\n".join([data[run.start : run.end] for run in runs])
+        start, end = 0, len(text)
+    only_integers = (
+        text.find(b".", start, end) < 0
+        and text.find(b"e", start, end) < 0
+        and text.count(b"E", start, end) == count * keyword.count(b"E")
+    )
+    if integer and not only_integers:
+        raise BulkParseError
+    starts, trailing = _line_offsets(source, runs)
+    with contextlib.suppress(BulkParseError):  # single blanks only: else renormalise, below
+        return _parse_block(text, start, end, starts, len(keyword), only_integers, trailing)
+    raw = _renormalised(text[start:end], keyword)
+    breaks = np.flatnonzero(np.frombuffer(raw, dtype=np.uint8) == 10)
+    if breaks.shape[0] != count - 1:
+        raise BulkParseError
+    starts = np.concatenate([[0], breaks + 1])
+    none = np.zeros(0, dtype=np.int64)
+    return _parse_block(raw, 0, len(raw), starts, len(keyword), only_integers, none)
+
+
 def _only_integers(data: bytes, run: Run) -> bool:
     """No decimal point or exponent in the run (beyond the keyword's own letters)."""
     keyword = run.keyword.encode()
@@ -286,18 +385,24 @@ def _only_integers(data: bytes, run: Run) -> bool:
 def _line_offsets(source: Source, runs: list[Run]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Where the lines of ``runs`` start and where a blank ends one (no separator, as many
     exporters leave it), as offsets into the runs' text joined by line breaks."""
-    starts: list[NDArray[np.int64]] = []
-    ends: list[NDArray[np.int64]] = []
-    shift = 0
-    for run in runs:
-        rows = slice(run.first - 1, run.first - 1 + run.count)
-        starts.append(source.starts[rows] - run.start + shift)
-        ends.append(source.ends[rows] - run.start + shift)
-        shift += run.end - run.start + 1
-    start, end = np.concatenate(starts), np.concatenate(ends)
+    if len(runs) == 1:
+        run = runs[0]
+        rows: slice | NDArray[np.int64] = slice(run.first - 1, run.first - 1 + run.count)
+        base: int | NDArray[np.int64] = run.start
+    else:
+        firsts = np.array([run.first - 1 for run in runs], dtype=np.int64)
+        counts = np.array([run.count for run in runs], dtype=np.int64)
+        spans = np.array([run.end - run.start + 1 for run in runs], dtype=np.int64)
+        run_starts = np.array([run.start for run in runs], dtype=np.int64)
+        shifts = np.concatenate([[0], np.cumsum(spans)[:-1]])
+        offsets = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        which = np.repeat(np.arange(len(runs)), counts)
+        rows = firsts[which] + (np.arange(which.shape[0]) - offsets[which])
+        base = (run_starts - shifts)[which]
+    absolute = source.ends[rows]
+    start = source.starts[rows] - base
     buffer = np.frombuffer(source.data, dtype=np.uint8)
-    absolute = np.concatenate([source.ends[r.first - 1 : r.first - 1 + r.count] for r in runs])
-    trailing = end[np.take(buffer, absolute - 1) == 32] - 1
+    trailing = (absolute - base)[np.take(buffer, absolute - 1) == 32] - 1
     return start, trailing
 
 

@@ -1,0 +1,317 @@
+"""The body of a TSurf, PLine or VSet read in bulk: all its element lines at once.
+
+The body of an object is everything from its first data line to its ``END``: runs of
+``VRTX`` / ``PVRTX`` / ``ATOM`` / ``PATOM`` lines, runs of cell lines (``TRGL`` or ``SEG``),
+part lines (``TFACE``, ``ILINE``, ``SUBVSET``) and ``BSTONE`` / ``BORDER`` lines. Rather than
+walking it run by run, :func:`read_body` classifies every line of the body with the file's
+keyword codes (:attr:`Source.codes`, numpy over the line starts), parses all the lines of
+each keyword in one go (:func:`~geobrep.adapters.gocad._lexer.parse_rows`) and puts the rows
+back in file order with array operations: a few Python steps per object, not per run or line.
+
+It reads only bodies it can read exactly as the run-by-run parser does. Anything else (a
+line it does not know, a flag word, a ragged or non-numeric row, data before the first part,
+a non-finite property value, more filled-in values than allowed) makes it return None, and
+the parser reads the object as before, with its warnings and its error messages naming the
+line.
+"""
+
+from __future__ import annotations
+
+import bisect
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from geobrep.adapters.gocad._lexer import KEYWORDS, BulkParseError, Run, Source, parse_rows
+from geobrep.adapters.gocad._numbers import parse_int
+from geobrep.adapters.gocad._records import Border, BStone
+from geobrep.geometry.arrays import FloatArray, IntArray
+
+__all__ = ["BULK_BODIES", "Body", "VertexRows", "read_body"]
+
+#: Read the bodies of TSurfs, PLines and VSets in bulk (tests turn it off to compare).
+BULK_BODIES = True
+
+#: Object type -> (its cell keyword and cell width, the keywords that start a part).
+_KINDS: dict[str, tuple[str | None, int, tuple[str, ...]]] = {
+    "TSurf": ("TRGL", 3, ("TFACE", "3DFACE", "ILINE", "TVOLUME", "SUBVSET")),
+    "PLine": ("SEG", 2, ("TFACE", "3DFACE", "ILINE", "TVOLUME", "SUBVSET")),
+    "VSet": (None, 0, ("SUBVSET",)),
+}
+_VERTEX_KEYWORDS = ("VRTX", "PVRTX", "ATOM", "PATOM")
+_ID_LIMIT = 2**53  # ids read as floats are exact below this
+#: Flag of a vertex whose property values come from the vertex it refers to (_tables).
+INHERIT = 64
+
+
+@dataclass(frozen=True)
+class VertexRows:
+    """The vertex lines of a body in file order (the columns of a vertex table chunk)."""
+
+    ids: IntArray
+    xyz: FloatArray
+    refs: IntArray  # the vertex an ATOM / PATOM line refers to, else -1
+    values: FloatArray
+    flags: NDArray[np.int8]
+    lines: IntArray
+
+
+@dataclass(frozen=True)
+class Body:
+    """What :func:`read_body` read: the body's rows, and where it ends."""
+
+    end: int
+    """0-based index of the body's ``END`` line."""
+    parts: list[tuple[str, str, int, int]]
+    """Each part line: its keyword, its text, its line number and the vertices before it."""
+    vertices: VertexRows
+    absent_rows: int
+    """Vertices without property values of their own when the object declares some."""
+    cells: tuple[IntArray, FloatArray, IntArray, IntArray] | None
+    """Cell vertex ids, values, part indices and line numbers (None for a VSet)."""
+    bstones: list[BStone]
+    borders: list[Border]
+
+
+def _keyword(text: str) -> str:
+    head = text.split(None, 1)
+    return head[0].upper() if head else ""
+
+
+def _row_lines(runs: list[Run]) -> IntArray:
+    """The 1-based line numbers of the lines of ``runs``."""
+    if len(runs) == 1:
+        return np.arange(runs[0].first, runs[0].first + runs[0].count, dtype=np.int64)
+    counts = np.array([run.count for run in runs], dtype=np.int64)
+    firsts = np.array([run.first for run in runs], dtype=np.int64)
+    offsets = np.cumsum(counts) - counts
+    which = np.repeat(np.arange(len(runs)), counts)
+    lines: IntArray = firsts[which] + (np.arange(which.shape[0]) - offsets[which])
+    return lines
+
+
+def _body_end(
+    source: Source, lo: int, parts_allowed: tuple[str, ...]
+) -> tuple[int, list[tuple[str, str, int]]] | None:
+    """The 0-based index of the ``END`` that closes the body starting at line ``lo`` and the
+    body's part lines (keyword, text, 1-based line); None when the body holds a line of
+    another kind (the parser reads it)."""
+    others = source.others
+    parts: list[tuple[str, str, int]] = []
+    for index in others[bisect.bisect_left(others, lo) :]:
+        text = source.text(index).strip()
+        if not text or (text.startswith("#") and not text.startswith("# CTETRA")):
+            continue
+        keyword = _keyword(text)
+        if keyword == "END":
+            return index, parts
+        if keyword not in parts_allowed:
+            return None
+        parts.append((keyword, text, index + 1))
+    return None
+
+
+def _ids(block: NDArray[np.float64] | IntArray, columns: int) -> IntArray | None:
+    """The first ``columns`` columns of a parsed block as int64 ids (None unless integral)."""
+    ids = block[:, :columns]
+    if ids.dtype == np.int64:
+        return np.ascontiguousarray(ids)
+    if ids.size and ((ids != np.floor(ids)).any() or (np.abs(ids) > _ID_LIMIT).any()):
+        return None
+    return np.ascontiguousarray(ids, dtype=np.int64)
+
+
+def _single_ids_exact(source: Source, runs: list[Run], columns: int) -> bool:
+    """Runs of one line are read line by line today, where an id must be an integer token
+    (``1.0`` is not): the ids of those lines, checked that way."""
+    for run in runs:
+        if run.count != 1:
+            continue
+        tokens = source.text(run.first - 1).split()
+        try:
+            for token in tokens[1 : 1 + columns]:
+                parse_int(token)
+        except ValueError:
+            return False
+    return True
+
+
+def read_body(
+    source: Source,
+    first: int,
+    kind: str,
+    n_point: int,
+    n_cell: int,
+    absent_room: int | None,
+) -> Body | None:
+    """The body of a ``kind`` object whose first data line is line ``first`` (1-based), or
+    None when the body is not one this bulk reader reads exactly as the parser does.
+
+    ``n_point`` / ``n_cell``: property values per vertex and per cell; ``absent_room``: how
+    many more property values the vertex table may fill in (None: no limit).
+    """
+    if not BULK_BODIES or kind not in _KINDS:
+        return None
+    cell_keyword, _, part_keywords = _KINDS[kind]
+    lo = first - 1
+    found = _body_end(source, lo, part_keywords)
+    if found is None:
+        return None
+    end, part_lines = found
+    runs: dict[str, list[Run]] = {}
+    codes = source.codes[lo:end]
+    change = np.flatnonzero(codes[1:] != codes[:-1]) + 1
+    bounds = np.concatenate([[0], change, [end - lo]])
+    heads = codes[bounds[:-1]].tolist()
+    los = (bounds[:-1] + lo).tolist()
+    his = (bounds[1:] + lo).tolist()
+    starts = source.starts[bounds[:-1] + lo].tolist()
+    ends = source.ends[bounds[1:] + lo - 1].tolist()
+    for code, a, b, start, stop in zip(heads, los, his, starts, ends, strict=True):
+        if code:
+            keyword = KEYWORDS[code - 1]
+            runs.setdefault(keyword, []).append(Run(keyword, a + 1, b - a, start, stop))
+    allowed = {*_VERTEX_KEYWORDS, "BSTONE", "BORDER"}
+    if cell_keyword is not None:
+        allowed.add(cell_keyword)
+    if not allowed.issuperset(runs) or ("PATOM" in runs and not n_point):
+        return None
+    try:
+        return _read(source, runs, part_lines, end, kind, n_point, n_cell, absent_room)
+    except BulkParseError:
+        return None
+
+
+def _read(
+    source: Source,
+    runs: dict[str, list[Run]],
+    part_lines: list[tuple[str, str, int]],
+    end: int,
+    kind: str,
+    n_point: int,
+    n_cell: int,
+    absent_room: int | None,
+) -> Body | None:
+    cell_keyword, cell_width, _ = _KINDS[kind]
+    first_part = part_lines[0][2] if part_lines else None
+    pieces: list[tuple[IntArray, FloatArray, IntArray, FloatArray, NDArray[np.int8], IntArray]]
+    pieces = []
+    absent_rows = 0
+    for keyword in _VERTEX_KEYWORDS:
+        these = runs.get(keyword)
+        if not these:
+            continue
+        if kind != "VSet" and (first_part is None or these[0].first < first_part):
+            return None  # data before any part: the parser warns and starts one
+        atom = keyword in ("ATOM", "PATOM")
+        own_values = keyword in ("PVRTX", "PATOM")
+        id_columns = 2 if atom else 1
+        width = (2 if atom else 4) + (n_point if own_values else 0)
+        block = parse_rows(source, these, integer=keyword == "ATOM")
+        if block.shape[1] != width:
+            return None
+        ids = _ids(block, id_columns)
+        if ids is None or not _single_ids_exact(source, these, id_columns):
+            return None
+        n = block.shape[0]
+        if own_values:
+            values = np.ascontiguousarray(block[:, width - n_point :], dtype=np.float64)
+            if not np.isfinite(values).all():
+                return None  # the parser counts and reports them
+        else:
+            values = np.full((n, n_point), np.nan)
+            absent_rows += n if n_point else 0
+        xyz = (
+            np.full((n, 3), np.nan)
+            if atom
+            else np.ascontiguousarray(block[:, 1:4], dtype=np.float64)
+        )
+        inherit = INHERIT if keyword == "ATOM" and n_point else 0
+        pieces.append(
+            (
+                ids[:, 0],
+                xyz,
+                ids[:, 1] if atom else np.full(n, -1, dtype=np.int64),
+                values,
+                np.full(n, inherit, dtype=np.int8),
+                _row_lines(these),
+            )
+        )
+    if absent_rows and absent_room is not None and absent_rows * n_point > absent_room:
+        return None  # the parser names the line past the limit
+    if not pieces:
+        vertices = VertexRows(
+            np.zeros(0, dtype=np.int64),
+            np.zeros((0, 3)),
+            np.zeros(0, dtype=np.int64),
+            np.zeros((0, n_point)),
+            np.zeros(0, dtype=np.int8),
+            np.zeros(0, dtype=np.int64),
+        )
+    elif len(pieces) == 1:
+        vertices = VertexRows(*pieces[0])
+    else:
+        columns = [np.concatenate(column) for column in zip(*pieces, strict=True)]
+        order = np.argsort(columns[5], kind="stable")
+        vertices = VertexRows(*(column[order] for column in columns))
+    vertex_lines = vertices.lines
+    parts = [
+        (keyword, text, line, start)
+        for (keyword, text, line), start in zip(
+            part_lines,
+            np.searchsorted(vertex_lines, [line for _, _, line in part_lines]).tolist(),
+            strict=True,
+        )
+    ]
+    cells = None
+    if cell_keyword is not None:
+        cells = _cells(source, runs.get(cell_keyword), part_lines, cell_width, n_cell)
+        if cells is None:
+            return None
+    bstones: list[BStone] = []
+    borders: list[Border] = []
+    if "BSTONE" in runs:
+        block = parse_rows(source, runs["BSTONE"], integer=True)
+        if block.shape[1] != 1:
+            return None
+        lines = _row_lines(runs["BSTONE"]).tolist()
+        bstones = list(map(BStone._make, zip(block[:, 0].tolist(), lines, strict=True)))
+    if "BORDER" in runs:
+        block = parse_rows(source, runs["BORDER"], integer=True)
+        if block.shape[1] != 3:
+            return None
+        rows = block.tolist()
+        borders = [
+            Border(a, b, c, line)
+            for (a, b, c), line in zip(rows, _row_lines(runs["BORDER"]).tolist(), strict=True)
+        ]
+    return Body(end, parts, vertices, absent_rows, cells, bstones, borders)
+
+
+def _cells(
+    source: Source,
+    runs: list[Run] | None,
+    part_lines: list[tuple[str, str, int]],
+    width: int,
+    n_cell: int,
+) -> tuple[IntArray, FloatArray, IntArray, IntArray] | None:
+    """The cell lines of a body: vertex ids, values, part indices, line numbers."""
+    if not runs:
+        empty = np.zeros(0, dtype=np.int64)
+        return np.zeros((0, width), dtype=np.int64), np.zeros((0, n_cell)), empty, empty.copy()
+    if not part_lines or runs[0].first < part_lines[0][2]:
+        return None  # a cell before any part: the parser warns and starts one
+    block = parse_rows(source, runs, integer=not n_cell)
+    if block.shape[1] != width + n_cell:
+        return None
+    ids = _ids(block, width)
+    if ids is None or (n_cell and not _single_ids_exact(source, runs, width)):
+        return None
+    values = np.ascontiguousarray(block[:, width:], dtype=np.float64)
+    if n_cell and not np.isfinite(values).all():
+        return None
+    lines = _row_lines(runs)
+    part_starts = np.array([line for _, _, line in part_lines], dtype=np.int64)
+    parts = np.searchsorted(part_starts, lines) - 1
+    return ids, values, parts.astype(np.int64), lines
