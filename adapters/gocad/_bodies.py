@@ -159,33 +159,107 @@ def read_body(
     if found is None:
         return None
     end, part_lines = found
-    runs: dict[str, list[Run]] = {}
-    codes = source.codes[lo:end]
-    change = np.flatnonzero(codes[1:] != codes[:-1]) + 1
-    bounds = np.concatenate([[0], change, [end - lo]])
-    heads = codes[bounds[:-1]].tolist()
-    los = (bounds[:-1] + lo).tolist()
-    his = (bounds[1:] + lo).tolist()
-    starts = source.starts[bounds[:-1] + lo].tolist()
-    ends = source.ends[bounds[1:] + lo - 1].tolist()
-    for code, a, b, start, stop in zip(heads, los, his, starts, ends, strict=True):
-        if code:
-            keyword = KEYWORDS[code - 1]
-            runs.setdefault(keyword, []).append(Run(keyword, a + 1, b - a, start, stop))
+    table = _FileRuns.of(source)
+    runs: dict[str, list[int]] = {}
+    for index in range(*table.between(lo, end)):
+        runs.setdefault(table.runs[index].keyword, []).append(index)
     allowed = {*_VERTEX_KEYWORDS, "BSTONE", "BORDER"}
     if cell_keyword is not None:
         allowed.add(cell_keyword)
     if not allowed.issuperset(runs) or ("PATOM" in runs and not n_point):
         return None
     try:
-        return _read(source, runs, part_lines, end, kind, n_point, n_cell, absent_room)
+        return _read(table, runs, part_lines, end, kind, n_point, n_cell, absent_room)
     except BulkParseError:
         return None
 
 
+class _FileRuns:
+    """Every run of lines of one of :data:`KEYWORDS` in a file, and their numbers parsed
+    together: the runs of a keyword whose first lines have as many blanks make one group,
+    parsed in one go the first time a body needs one of them (a group the bulk parse
+    rejects is left unparsed: each body then parses its own runs)."""
+
+    def __init__(self, source: Source) -> None:
+        self.source = source
+        codes = source.codes
+        change = np.flatnonzero(codes[1:] != codes[:-1]) + 1
+        bounds = np.concatenate([[0], change, [codes.shape[0]]])
+        lo, hi = bounds[:-1], bounds[1:]
+        keep = codes[lo] != 0
+        lo, hi = lo[keep], hi[keep]
+        self.firsts: list[int] = (lo + 1).tolist()
+        self.runs = [
+            Run(KEYWORDS[code - 1], first, count, start, end)
+            for code, first, count, start, end in zip(
+                codes[lo].tolist(),
+                self.firsts,
+                (hi - lo).tolist(),
+                source.starts[lo].tolist(),
+                source.ends[hi - 1].tolist(),
+                strict=True,
+            )
+        ]
+        self._place: dict[int, tuple[int, int]] = {}  # run -> (group, first row)
+        self._blocks: list[NDArray[np.float64] | IntArray | None] = []
+        self._parsed: set[str] = set()
+
+    @classmethod
+    def of(cls, source: Source) -> _FileRuns:
+        found = source.cache.get(cls)
+        if not isinstance(found, cls):
+            found = source.cache[cls] = cls(source)
+        return found
+
+    def between(self, lo: int, end: int) -> tuple[int, int]:
+        """The indices of the runs within the 0-based lines ``[lo, end)``."""
+        return bisect.bisect_left(self.firsts, lo + 1), bisect.bisect_left(self.firsts, end + 1)
+
+    def rows(self, indices: list[int], integer: bool) -> NDArray[np.float64] | IntArray:
+        """The numbers of the runs ``indices`` (runs of one keyword, in file order), as
+        :func:`parse_rows` reads them; BulkParseError when it cannot."""
+        keyword = self.runs[indices[0]].keyword
+        if keyword not in self._parsed:
+            self._parse_groups(keyword)
+        group, offset = self._place.get(indices[0], (-1, 0))
+        block = self._blocks[group] if group >= 0 else None
+        count = sum(self.runs[i].count for i in indices)
+        last_group, last_offset = self._place.get(indices[-1], (-2, 0))
+        if (
+            block is None
+            or last_group != group
+            or last_offset + self.runs[indices[-1]].count - offset != count
+            or (integer and block.dtype != np.int64)
+        ):
+            return parse_rows(self.source, [self.runs[i] for i in indices], integer)
+        return block[offset : offset + count]
+
+    def _parse_groups(self, keyword: str) -> None:
+        self._parsed.add(keyword)
+        data = self.source.data
+        ends = self.source.ends
+        groups: dict[int, list[int]] = {}
+        for index, run in enumerate(self.runs):
+            if run.keyword != keyword:
+                continue
+            first_end = int(ends[run.first - 1])
+            width = data.count(b" ", run.start, first_end) - (data[first_end - 1] == 32)
+            groups.setdefault(width, []).append(index)
+        for indices in groups.values():
+            try:
+                block = parse_rows(self.source, [self.runs[i] for i in indices], False)
+            except BulkParseError:
+                continue
+            self._blocks.append(block)
+            offset = 0
+            for index in indices:
+                self._place[index] = (len(self._blocks) - 1, offset)
+                offset += self.runs[index].count
+
+
 def _read(
-    source: Source,
-    runs: dict[str, list[Run]],
+    table: _FileRuns,
+    runs: dict[str, list[int]],
     part_lines: list[tuple[str, str, int]],
     end: int,
     kind: str,
@@ -194,21 +268,23 @@ def _read(
     absent_room: int | None,
 ) -> Body | None:
     cell_keyword, cell_width, _ = _KINDS[kind]
+    source = table.source
     first_part = part_lines[0][2] if part_lines else None
     pieces: list[tuple[IntArray, FloatArray, IntArray, FloatArray, NDArray[np.int8], IntArray]]
     pieces = []
     absent_rows = 0
     for keyword in _VERTEX_KEYWORDS:
-        these = runs.get(keyword)
-        if not these:
+        indices = runs.get(keyword)
+        if not indices:
             continue
+        these = [table.runs[i] for i in indices]
         if kind != "VSet" and (first_part is None or these[0].first < first_part):
             return None  # data before any part: the parser warns and starts one
         atom = keyword in ("ATOM", "PATOM")
         own_values = keyword in ("PVRTX", "PATOM")
         id_columns = 2 if atom else 1
         width = (2 if atom else 4) + (n_point if own_values else 0)
-        block = parse_rows(source, these, integer=keyword == "ATOM")
+        block = table.rows(indices, integer=keyword == "ATOM")
         if block.shape[1] != width:
             return None
         ids = _ids(block, id_columns)
@@ -266,47 +342,47 @@ def _read(
     ]
     cells = None
     if cell_keyword is not None:
-        cells = _cells(source, runs.get(cell_keyword), part_lines, cell_width, n_cell)
+        cells = _cells(table, runs.get(cell_keyword), part_lines, cell_width, n_cell)
         if cells is None:
             return None
     bstones: list[BStone] = []
     borders: list[Border] = []
     if "BSTONE" in runs:
-        block = parse_rows(source, runs["BSTONE"], integer=True)
+        block = table.rows(runs["BSTONE"], integer=True)
         if block.shape[1] != 1:
             return None
-        lines = _row_lines(runs["BSTONE"]).tolist()
+        lines = _row_lines([table.runs[i] for i in runs["BSTONE"]]).tolist()
         bstones = list(map(BStone._make, zip(block[:, 0].tolist(), lines, strict=True)))
     if "BORDER" in runs:
-        block = parse_rows(source, runs["BORDER"], integer=True)
+        block = table.rows(runs["BORDER"], integer=True)
         if block.shape[1] != 3:
             return None
-        rows = block.tolist()
+        lines = _row_lines([table.runs[i] for i in runs["BORDER"]]).tolist()
         borders = [
-            Border(a, b, c, line)
-            for (a, b, c), line in zip(rows, _row_lines(runs["BORDER"]).tolist(), strict=True)
+            Border(a, b, c, line) for (a, b, c), line in zip(block.tolist(), lines, strict=True)
         ]
     return Body(end, parts, vertices, absent_rows, cells, bstones, borders)
 
 
 def _cells(
-    source: Source,
-    runs: list[Run] | None,
+    table: _FileRuns,
+    indices: list[int] | None,
     part_lines: list[tuple[str, str, int]],
     width: int,
     n_cell: int,
 ) -> tuple[IntArray, FloatArray, IntArray, IntArray] | None:
     """The cell lines of a body: vertex ids, values, part indices, line numbers."""
-    if not runs:
+    if not indices:
         empty = np.zeros(0, dtype=np.int64)
         return np.zeros((0, width), dtype=np.int64), np.zeros((0, n_cell)), empty, empty.copy()
+    runs = [table.runs[i] for i in indices]
     if not part_lines or runs[0].first < part_lines[0][2]:
         return None  # a cell before any part: the parser warns and starts one
-    block = parse_rows(source, runs, integer=not n_cell)
+    block = table.rows(indices, integer=not n_cell)
     if block.shape[1] != width + n_cell:
         return None
     ids = _ids(block, width)
-    if ids is None or (n_cell and not _single_ids_exact(source, runs, width)):
+    if ids is None or (n_cell and not _single_ids_exact(table.source, runs, width)):
         return None
     values = np.ascontiguousarray(block[:, width:], dtype=np.float64)
     if n_cell and not np.isfinite(values).all():

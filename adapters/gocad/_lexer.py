@@ -73,23 +73,27 @@ class Source:
     def __init__(self, path: Path, data: bytes) -> None:
         self.path = path
         buffer = np.frombuffer(data, dtype=np.uint8)
-        # most files have no CR at all: one memchr instead of a pass of numpy
-        returns = np.flatnonzero(buffer == 13) if b"\r" in data else np.zeros(0, np.int64)
-        if returns.size:
-            after = np.take(buffer, returns + 1, mode="clip")
-            if returns[-1] == len(data) - 1 or (after != 10).any():  # lone CRs
+        breaks = np.flatnonzero(buffer == 10)
+        crlf: NDArray[np.bool_] | None = None
+        if b"\r" in data:  # (a memchr: most files have none)
+            crlf = buffer[np.maximum(breaks - 1, 0)] == 13
+            if np.count_nonzero(buffer == 13) != np.count_nonzero(crlf):  # lone CRs
                 data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
                 buffer = np.frombuffer(data, dtype=np.uint8)
-                returns = returns[:0]
+                breaks = np.flatnonzero(buffer == 10)
+                crlf = None
         self.data = data
-        breaks = np.flatnonzero(buffer == 10)
-        self.starts = np.concatenate([[0], breaks + 1]).astype(np.int64)
-        self.ends = np.concatenate([breaks, [len(data)]]).astype(np.int64)
-        if self.starts[-1] == len(data):  # a final newline does not start a line
-            self.starts, self.ends = self.starts[:-1], self.ends[:-1]
-        if returns.size:  # CRLF: a line ends before its CR
-            before = np.take(buffer, np.maximum(self.ends - 1, 0))
-            self.ends -= (before == 13) & (self.ends > self.starts)
+        # a final newline starts no line
+        n = breaks.shape[0] + (len(data) > 0 and not data.endswith(b"\n"))
+        self.starts = np.empty(n, dtype=np.int64)
+        self.ends = np.empty(n, dtype=np.int64)
+        if n:
+            self.starts[0] = 0
+            self.starts[1:] = breaks[: n - 1] + 1
+            self.ends[: breaks.shape[0]] = breaks
+            self.ends[breaks.shape[0] :] = len(data)
+        if crlf is not None:  # a line ends before its CR
+            self.ends[: breaks.shape[0]] -= crlf
         self.runs: list[Run] = []
         """Every bulk run of the file (filled by :func:`scan`)."""
         self.batched: dict[int, NDArray[Any]] | None = None
@@ -97,6 +101,8 @@ class Source:
         self._codes: NDArray[np.int8] | None = None
         self._pairs: list[tuple[int, int]] | None = None
         self._others: list[int] | None = None
+        self.cache: dict[type, object] = {}
+        """What readers of the file's parts keep about the whole file (by their type)."""
 
     @property
     def codes(self) -> NDArray[np.int8]:
@@ -139,32 +145,28 @@ def decode(raw: bytes) -> str:
 def keyword_codes(source: Source) -> NDArray[np.int8]:
     """Per line: index + 1 of the keyword of :data:`KEYWORDS` it starts with (followed by a
     blank or a tab), or 0."""
-    width = 1 + max(map(len, KEYWORDS))
-    buffer = np.frombuffer(source.data, dtype=np.uint8)
-    # One gather per byte; past the end of the file the last byte repeats (a letter or a line
-    # break, never the space or tab that must follow a keyword).
-    columns = [np.take(buffer, source.starts + k, mode="clip") for k in range(width)]
-    # the first 4 bytes of each line as one integer: one comparison per keyword
-    head = columns[0].astype(np.uint32)
-    for k in range(1, 4):
-        head |= columns[k].astype(np.uint32) << np.uint32(8 * k)
+    data, starts = source.data, source.starts
+    size = len(data)
+    # The first 8 bytes of every line as one little-endian integer (bytes past the end of
+    # the file are 0, never the blank or tab that must follow a keyword): one gather.
+    heads = np.zeros(source.n_lines, dtype=np.uint64)
+    inside = int(np.searchsorted(starts, size - 7)) if size >= 8 else 0
+    if inside:
+        words = np.ndarray(shape=(size - 7,), dtype="<u8", buffer=data, strides=(1,))
+        heads[:inside] = words[starts[:inside]]
+    for line in range(inside, source.n_lines):
+        heads[line] = int.from_bytes(data[int(starts[line]) : int(starts[line]) + 8], "little")
     codes = np.zeros(source.n_lines, dtype=np.int8)
+    masked: dict[int, NDArray[np.uint64]] = {}
     for index, keyword in enumerate(KEYWORDS, start=1):
         raw = keyword.encode()
-        key = np.uint32(int.from_bytes(raw[:4], "little"))
-        if len(raw) < 4:  # SEG: its three bytes
-            mask = np.uint32((1 << (8 * len(raw))) - 1)
-            candidates = np.flatnonzero((head & mask) == key)
-        else:
-            candidates = np.flatnonzero(head == key)
-        if not candidates.size:
-            continue
-        keep = np.ones(candidates.shape[0], dtype=bool)
-        for k in range(4, len(raw)):
-            keep &= columns[k][candidates] == raw[k]
-        follower = columns[len(raw)][candidates]
-        keep &= (follower == 32) | (follower == 9)
-        codes[candidates[keep]] = index
+        width = len(raw) + 1  # the keyword and its follower
+        if width not in masked:
+            masked[width] = heads & np.uint64((1 << (8 * width)) - 1)
+        head = masked[width]
+        match = head == np.uint64(int.from_bytes(raw + b" ", "little"))
+        match |= head == np.uint64(int.from_bytes(raw + b"\t", "little"))
+        codes[match] = index
     return codes
 
 
