@@ -272,7 +272,14 @@ def _read(
     first_part = part_lines[0][2] if part_lines else None
     pieces: list[tuple[IntArray, FloatArray, IntArray, FloatArray, NDArray[np.int8], IntArray]]
     pieces = []
-    absent_rows = 0
+    # vertices without values of their own, counted before any is filled in
+    absent_rows = (
+        sum(table.runs[i].count for k in ("VRTX", "ATOM") for i in runs.get(k, ()))
+        if n_point
+        else 0
+    )
+    if absent_rows and absent_room is not None and absent_rows * n_point > absent_room:
+        return None  # the parser names the line past the limit
     for keyword in _VERTEX_KEYWORDS:
         indices = runs.get(keyword)
         if not indices:
@@ -297,7 +304,6 @@ def _read(
                 return None  # the parser counts and reports them
         else:
             values = np.full((n, n_point), np.nan)
-            absent_rows += n if n_point else 0
         xyz = (
             np.full((n, 3), np.nan)
             if atom
@@ -314,8 +320,6 @@ def _read(
                 _row_lines(these),
             )
         )
-    if absent_rows and absent_room is not None and absent_rows * n_point > absent_room:
-        return None  # the parser names the line past the limit
     if not pieces:
         vertices = VertexRows(
             np.zeros(0, dtype=np.int64),
