@@ -126,7 +126,7 @@ def _single_ids_exact(source: Source, runs: list[Run], columns: int) -> bool:
     """Runs of one line are read line by line today, where an id must be an integer token
     (``1.0`` is not): the ids of those lines, checked that way."""
     for run in runs:
-        if run.count != 1:
+        if run.count > 1:
             continue
         tokens = source.text(run.first - 1).split()
         try:

@@ -498,8 +498,36 @@ def _parse_integers(
     count: int,
     trailing: NDArray[np.int64],
 ) -> NDArray[np.int64]:
-    """A run of integers (numpy's integer parser is faster than JSON's objects)."""
+    """A run of integers (numpy's integer parser is faster than JSON's objects).
+
+    Each keyword and its blank become a marker number (``-9...9``, as wide as the keyword)
+    that numpy reads with the rest: the lines are a rectangle when every row of the result
+    starts with the marker and no other number is the marker (else the blanks of each line
+    are counted instead)."""
     view = np.frombuffer(data, dtype=np.uint8, count=end - start, offset=start)
+    if data.find(b"-", start, end) >= 0:  # numpy reads a lone "-" as 0 and "1-2" as 1, -2
+        minus = np.flatnonzero(view == 45)
+        if minus[-1] + 1 == view.shape[0]:
+            raise BulkParseError
+        digit, before = view[minus + 1], view[minus - 1]
+        if not (((digit >= 48) & (digit <= 57)) & ((before == 32) | (before == 9))).all():
+            raise BulkParseError
+    text = np.frombuffer(bytearray(memoryview(data)[start:end]).translate(_INT_MAP), np.uint8)
+    skip = heads.shape[1]
+    marker = -(10 ** (skip - 2) - 1)
+    text[heads] = np.frombuffer(str(marker).encode() + b" ", dtype=np.uint8)
+    try:
+        array = np.fromstring(text, dtype=np.int64, sep=" ")  # type: ignore[call-overload]
+    except ValueError as exc:  # numpy stopped before the end of the text
+        raise BulkParseError from exc
+    step = array.shape[0] // count
+    if step >= 2 and step * count == array.shape[0]:
+        grid = array.reshape(count, step)
+        if (grid[:, 0] == marker).all() and np.count_nonzero(array == marker) == count:
+            if np.abs(grid[:, 1:]).max() >= _INT_LIMIT:
+                raise BulkParseError  # numpy saturated: let the exact path decide
+            result: NDArray[np.int64] = np.ascontiguousarray(grid[:, 1:])
+            return result
     # A rectangle: as many blanks on every line (a blank ending one aside), hence as many
     # numbers once numpy (which would accept repeated ones) has read the right total.
     is_blank = view == 32
@@ -509,20 +537,9 @@ def _parse_integers(
     width = int(per_line[0])
     if width == 0 or not (per_line == width).all():
         raise BulkParseError
-    if data.find(b"-", start, end) >= 0:  # numpy reads a lone "-" as 0
-        after = np.flatnonzero(view == 45) + 1
-        if after[-1] == view.shape[0]:
-            raise BulkParseError
-        digit = view[after]
-        if not ((digit >= 48) & (digit <= 57)).all():
-            raise BulkParseError
-    text = np.frombuffer(bytearray(memoryview(data)[start:end]).translate(_INT_MAP), np.uint8)
     text[heads] = 32
-    try:
-        array = np.fromstring(text, dtype=np.int64, sep=" ")  # type: ignore[call-overload]
-    except ValueError as exc:  # numpy stopped before the end of the text
-        raise BulkParseError from exc
+    array = np.fromstring(text, dtype=np.int64, sep=" ")  # type: ignore[call-overload]
     if array.shape[0] != count * width or (array.size and np.abs(array).max() >= _INT_LIMIT):
         raise BulkParseError  # a token numpy split or saturated: let the exact path decide
-    result: NDArray[np.int64] = array.reshape(count, width)
+    result = array.reshape(count, width)
     return result

@@ -164,9 +164,14 @@ class VertexTable:
         values = np.concatenate([c[3] for c in self._chunks])
         flags = np.concatenate([c[4] for c in self._chunks])
         lines = np.concatenate([c[5] for c in self._chunks])
-        order = np.argsort(ids, kind="stable")
-        sorted_ids = ids[order]
-        repeated = np.flatnonzero(sorted_ids[1:] == sorted_ids[:-1])
+        if bool((ids[1:] > ids[:-1]).all()):  # declared in increasing order: no sort
+            order = np.arange(ids.shape[0], dtype=np.int64)
+            sorted_ids = ids
+            repeated = np.zeros(0, dtype=np.int64)
+        else:
+            order = np.argsort(ids, kind="stable")
+            sorted_ids = ids[order]
+            repeated = np.flatnonzero(sorted_ids[1:] == sorted_ids[:-1])
         if repeated.size:
             first, second = sorted((int(order[repeated[0]]), int(order[repeated[0] + 1])))
             raise error(

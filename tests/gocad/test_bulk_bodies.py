@@ -13,7 +13,7 @@ import pytest
 from gocad_files import DATA, FILES, read_quietly
 
 from geobrep.adapters.gocad import _bodies
-from geobrep.adapters.gocad._lexer import Source
+from geobrep.adapters.gocad._lexer import BulkParseError, Source, parse_rows
 from geobrep.adapters.gocad._parser import GocadObject, parse_source
 from geobrep.errors import FormatError
 
@@ -133,6 +133,9 @@ MUTATIONS = [
     ("TRGL 4 6 5", "TRGL 4 6 5 9"),
     ("TRGL 4 6 5", "TRGL 4 6 99"),
     ("TRGL 4 6 5", "TRGL 4.0 6 5"),
+    ("TRGL 4 6 5", "TRGL 4 6-5"),
+    ("TRGL 4 6 5", "TRGL 4 6 -999"),
+    ("TRGL 4 6 5", "TRGL 4 6 -"),
     ("TRGL 1 2 3", "TRGL 1.5 2 3"),
     ("TRGL 1 2 3", "TRGL  1   2\t3  "),
     ("PVRTX 2 1 0 0.25 2.5 7", "PVRTX 2 1 0 0.25 2.5"),
@@ -239,3 +242,46 @@ def test_a_malformed_row_in_a_real_file(tmp_path: Path, monkeypatch: pytest.Monk
     with pytest.raises(FormatError) as runs:
         read_quietly(path)
     assert str(bulk.value) == str(runs.value)
+
+
+@pytest.mark.parametrize(
+    "rows",
+    [
+        ["1 2 3", "4 5 6"],
+        ["1 2 3 ", "4 5 6 "],
+        ["-1 2 3", "4 -5 6"],
+        ["-999 2 3", "4 5 -999"],  # the marker value itself
+        ["1  2\t3", "4 5 6"],
+        ["007 2 3", "4 5 6"],
+        ["1 2 3", "4 5"],
+        ["1 2 3 4", "4 5"],
+        ["1 2 3", "4 5 6 7", "8 9"],
+        ["12-3 4", "1 2 3"],
+        ["1 2 -", "4 5 6"],
+        ["1 2 3-", "4 5 6"],
+        ["1 2 +3", "4 5 6"],
+        ["99999999999999999999 2 3", "4 5 6"],
+    ],
+)
+@pytest.mark.parametrize("keyword", ["TRGL", "SEG", "BORDER"])
+def test_integer_rows_are_what_the_line_parser_reads(
+    tmp_path: Path, rows: list[str], keyword: str
+) -> None:
+    """One bulk parse of integer lines: the ids each line holds, or no bulk result when the
+    lines are ragged or hold a token the line parser would not read as one integer."""
+    path = tmp_path / "rows.txt"
+    path.write_text("".join(f"{keyword} {row}\n" for row in rows))
+    source = Source.read(path)
+    source.codes  # noqa: B018 - the runs come from the keyword codes
+    from geobrep.adapters.gocad._bodies import _FileRuns
+
+    runs = _FileRuns.of(source).runs
+    tokens = [row.split() for row in rows]
+    plain = all(t.lstrip("-").isdigit() and len(t) < 19 for row in tokens for t in row)
+    if plain and len({len(row) for row in tokens}) == 1:
+        assert parse_rows(source, runs, integer=True).tolist() == [
+            [int(t) for t in row] for row in tokens
+        ]
+    else:
+        with pytest.raises(BulkParseError):
+            parse_rows(source, runs, integer=True)
