@@ -8,8 +8,10 @@ parse (:func:`parse_run`) and walks only the few remaining lines in Python.
 
 from __future__ import annotations
 
+import bisect
 import contextlib
 import importlib
+import itertools
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,10 +23,25 @@ from numpy.typing import NDArray
 
 from geobrep.errors import FormatError
 
-__all__ = ["BULK_KEYWORDS", "ORJSON", "Line", "Run", "Source", "parse_run", "scan", "split_tokens"]
+__all__ = [
+    "BULK_KEYWORDS",
+    "KEYWORDS",
+    "ORJSON",
+    "Line",
+    "Run",
+    "Source",
+    "keyword_codes",
+    "parse_rows",
+    "parse_run",
+    "scan",
+    "split_tokens",
+]
 
 #: Keywords whose lines are parsed in bulk (the keyword, then numbers).
 BULK_KEYWORDS: tuple[str, ...] = ("VRTX", "PVRTX", "TRGL", "SEG", "TETRA", "ATOM", "PATOM")
+#: Every keyword :func:`keyword_codes` recognises: the bulk ones, then the id lines of a
+#: TSurf's borders (read in bulk by a whole body, see ``_bodies``; never a :class:`Run`).
+KEYWORDS: tuple[str, ...] = (*BULK_KEYWORDS, "BSTONE", "BORDER")
 
 
 @dataclass(frozen=True)
@@ -56,26 +73,50 @@ class Source:
     def __init__(self, path: Path, data: bytes) -> None:
         self.path = path
         buffer = np.frombuffer(data, dtype=np.uint8)
-        returns = np.flatnonzero(buffer == 13)
-        if returns.size:
-            after = np.take(buffer, returns + 1, mode="clip")
-            if returns[-1] == len(data) - 1 or (after != 10).any():  # lone CRs
+        breaks = np.flatnonzero(buffer == 10)
+        crlf: NDArray[np.bool_] | None = None
+        if b"\r" in data:  # (a memchr: most files have none)
+            crlf = buffer[np.maximum(breaks - 1, 0)] == 13
+            if np.count_nonzero(buffer == 13) != np.count_nonzero(crlf):  # lone CRs
                 data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
                 buffer = np.frombuffer(data, dtype=np.uint8)
-                returns = returns[:0]
+                breaks = np.flatnonzero(buffer == 10)
+                crlf = None
         self.data = data
-        breaks = np.flatnonzero(buffer == 10)
-        self.starts = np.concatenate([[0], breaks + 1]).astype(np.int64)
-        self.ends = np.concatenate([breaks, [len(data)]]).astype(np.int64)
-        if self.starts[-1] == len(data):  # a final newline does not start a line
-            self.starts, self.ends = self.starts[:-1], self.ends[:-1]
-        if returns.size:  # CRLF: a line ends before its CR
-            before = np.take(buffer, np.maximum(self.ends - 1, 0))
-            self.ends -= (before == 13) & (self.ends > self.starts)
+        # a final newline starts no line
+        n = breaks.shape[0] + (len(data) > 0 and not data.endswith(b"\n"))
+        self.starts = np.empty(n, dtype=np.int64)
+        self.ends = np.empty(n, dtype=np.int64)
+        if n:
+            self.starts[0] = 0
+            self.starts[1:] = breaks[: n - 1] + 1
+            self.ends[: breaks.shape[0]] = breaks
+            self.ends[breaks.shape[0] :] = len(data)
+        if crlf is not None:  # a line ends before its CR
+            self.ends[: breaks.shape[0]] -= crlf
         self.runs: list[Run] = []
         """Every bulk run of the file (filled by :func:`scan`)."""
         self.batched: dict[int, NDArray[Any]] | None = None
         """Run first line -> its numbers, parsed together with the runs like it."""
+        self._codes: NDArray[np.int8] | None = None
+        self._pairs: list[tuple[int, int]] | None = None
+        self._others: list[int] | None = None
+        self.cache: dict[type, object] = {}
+        """What readers of the file's parts keep about the whole file (by their type)."""
+
+    @property
+    def codes(self) -> NDArray[np.int8]:
+        """Per line: index + 1 of its keyword in :data:`KEYWORDS`, or 0 (computed once)."""
+        if self._codes is None:
+            self._codes = keyword_codes(self)
+        return self._codes
+
+    @property
+    def others(self) -> list[int]:
+        """0-based indices of the lines that start with none of :data:`KEYWORDS`."""
+        if self._others is None:
+            self._others = np.flatnonzero(self.codes == 0).tolist()
+        return self._others
 
     @classmethod
     def read(cls, path: Path) -> Source:
@@ -101,54 +142,77 @@ def decode(raw: bytes) -> str:
         return raw.decode("latin-1")
 
 
-def _keyword_codes(source: Source) -> NDArray[np.int8]:
-    """Per line: index + 1 of its bulk keyword in :data:`BULK_KEYWORDS`, or 0."""
-    width = 7
-    buffer = np.frombuffer(source.data, dtype=np.uint8)
-    # One gather per byte; past the end of the file the last byte repeats (a letter or a line
-    # break, never the space or tab that must follow a keyword).
-    columns = [np.take(buffer, source.starts + k, mode="clip") for k in range(width)]
+def keyword_codes(source: Source) -> NDArray[np.int8]:
+    """Per line: index + 1 of the keyword of :data:`KEYWORDS` it starts with (followed by a
+    blank or a tab), or 0."""
+    data, starts = source.data, source.starts
+    size = len(data)
+    # The first 8 bytes of every line as one little-endian integer (bytes past the end of
+    # the file are 0, never the blank or tab that must follow a keyword): one gather.
+    heads = np.zeros(source.n_lines, dtype=np.uint64)
+    inside = int(np.searchsorted(starts, size - 7)) if size >= 8 else 0
+    if inside:
+        words = np.ndarray(shape=(size - 7,), dtype="<u8", buffer=data, strides=(1,))
+        heads[:inside] = words[starts[:inside]]
+    for line in range(inside, source.n_lines):
+        heads[line] = int.from_bytes(data[int(starts[line]) : int(starts[line]) + 8], "little")
     codes = np.zeros(source.n_lines, dtype=np.int8)
-    for index, keyword in enumerate(BULK_KEYWORDS, start=1):
-        match = np.ones(source.n_lines, dtype=bool)
-        for k, byte in enumerate(keyword.encode()):
-            match &= columns[k] == byte
-        follower = columns[len(keyword)]
-        match &= (follower == 32) | (follower == 9)
+    masked: dict[int, NDArray[np.uint64]] = {}
+    for index, keyword in enumerate(KEYWORDS, start=1):
+        raw = keyword.encode()
+        width = len(raw) + 1  # the keyword and its follower
+        if width not in masked:
+            masked[width] = heads & np.uint64((1 << (8 * width)) - 1)
+        head = masked[width]
+        match = head == np.uint64(int.from_bytes(raw + b" ", "little"))
+        match |= head == np.uint64(int.from_bytes(raw + b"\t", "little"))
         codes[match] = index
     return codes
 
 
-def scan(source: Source) -> Iterator[Line | Run]:
-    """Yield the file's content in order: bulk :class:`Run` s and other :class:`Line` s.
+def _runs(source: Source) -> list[tuple[int, int]]:
+    """The file's stretches of lines ``[lo, hi)`` (0-based), each a bulk run or lines that
+    are none; fills :attr:`Source.runs` (computed once)."""
+    if source._pairs is not None:
+        return source._pairs
+    codes = source.codes.copy()
+    codes[codes > len(BULK_KEYWORDS)] = 0  # BSTONE, BORDER: lines of their own
+    n = codes.shape[0]
+    change = np.flatnonzero(codes[1:] != codes[:-1]) + 1
+    bounds = np.concatenate([[0], change, [n]]).tolist() if n else [0]
+    source._pairs = list(itertools.pairwise(bounds))
+    bulk = [(lo, hi) for lo, hi in source._pairs if codes[lo]]
+    starts = source.starts[[lo for lo, _ in bulk]].tolist()
+    ends = source.ends[[hi - 1 for _, hi in bulk]].tolist()
+    source.runs = [
+        Run(BULK_KEYWORDS[int(codes[lo]) - 1], lo + 1, hi - lo, start, end)
+        for (lo, hi), start, end in zip(bulk, starts, ends, strict=True)
+    ]
+    return source._pairs
+
+
+def _first(run: Run) -> int:
+    return run.first
+
+
+def scan(source: Source, start: int = 0) -> Iterator[Line | Run]:
+    """Yield the file's content in order: bulk :class:`Run` s and other :class:`Line` s,
+    from the 0-based line ``start`` on (a run ``start`` cuts is yielded whole).
 
     Blank lines are dropped; so are comment lines starting with ``#``, except ``# CTETRA``
     lines, which carry TSolid data.
     """
-    codes = _keyword_codes(source)
-    n = codes.shape[0]
-    if n == 0:
+    pairs = _runs(source)
+    codes = source.codes
+    first = max(bisect.bisect_right(pairs, (start, source.n_lines + 1)) - 1, 0)
+    if first >= len(pairs):
         return
-    change = np.flatnonzero(codes[1:] != codes[:-1]) + 1
-    bounds = np.concatenate([[0], change, [n]])
-    pairs = list(zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True))
-    source.runs = [
-        Run(
-            BULK_KEYWORDS[int(codes[lo]) - 1],
-            lo + 1,
-            hi - lo,
-            int(source.starts[lo]),
-            int(source.ends[hi - 1]),
-        )
-        for lo, hi in pairs
-        if codes[lo]
-    ]
-    runs = iter(source.runs)
-    for lo, hi in pairs:
-        if codes[lo]:
+    runs = iter(source.runs[bisect.bisect_left(source.runs, pairs[first][0] + 1, key=_first) :])
+    for lo, hi in pairs[first:]:
+        if 0 < codes[lo] <= len(BULK_KEYWORDS):
             yield next(runs)
             continue
-        for index in range(lo, hi):
+        for index in range(max(lo, start), hi):
             text = source.text(index).strip()
             if not text or (text.startswith("#") and not text.startswith("# CTETRA")):
                 continue
@@ -273,6 +337,43 @@ def parse_run(source: Source, run: Run, integer: bool) -> NDArray[Any]:
     return _parse_block(raw, 0, len(raw), starts, len(keyword), only_integers, none)
 
 
+def parse_rows(source: Source, runs: list[Run], integer: bool) -> NDArray[Any]:
+    """The numbers after the keyword of every line of ``runs`` (runs of one keyword, in file
+    order) as one 2-D array, as :func:`parse_run` reads each run (int64 when the runs hold
+    integers only, else float64; ``integer``: they must).
+
+    Raises :class:`BulkParseError` when the lines are not a rectangle of plain numbers (or
+    the speed-up library is missing): the caller then reads them the way it reads any run.
+    """
+    if ORJSON is None or not runs:
+        raise BulkParseError
+    keyword = runs[0].keyword.encode()
+    data = source.data
+    count = sum(run.count for run in runs)
+    if len(runs) == 1:
+        text, start, end = data, runs[0].start, runs[0].end
+    else:
+        text = b"\n".join([data[run.start : run.end] for run in runs])
+        start, end = 0, len(text)
+    only_integers = (
+        text.find(b".", start, end) < 0
+        and text.find(b"e", start, end) < 0
+        and text.count(b"E", start, end) == count * keyword.count(b"E")
+    )
+    if integer and not only_integers:
+        raise BulkParseError
+    starts, trailing = _line_offsets(source, runs)
+    with contextlib.suppress(BulkParseError):  # single blanks only: else renormalise, below
+        return _parse_block(text, start, end, starts, len(keyword), only_integers, trailing)
+    raw = _renormalised(text[start:end], keyword)
+    breaks = np.flatnonzero(np.frombuffer(raw, dtype=np.uint8) == 10)
+    if breaks.shape[0] != count - 1:
+        raise BulkParseError
+    starts = np.concatenate([[0], breaks + 1])
+    none = np.zeros(0, dtype=np.int64)
+    return _parse_block(raw, 0, len(raw), starts, len(keyword), only_integers, none)
+
+
 def _only_integers(data: bytes, run: Run) -> bool:
     """No decimal point or exponent in the run (beyond the keyword's own letters)."""
     keyword = run.keyword.encode()
@@ -286,18 +387,24 @@ def _only_integers(data: bytes, run: Run) -> bool:
 def _line_offsets(source: Source, runs: list[Run]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Where the lines of ``runs`` start and where a blank ends one (no separator, as many
     exporters leave it), as offsets into the runs' text joined by line breaks."""
-    starts: list[NDArray[np.int64]] = []
-    ends: list[NDArray[np.int64]] = []
-    shift = 0
-    for run in runs:
-        rows = slice(run.first - 1, run.first - 1 + run.count)
-        starts.append(source.starts[rows] - run.start + shift)
-        ends.append(source.ends[rows] - run.start + shift)
-        shift += run.end - run.start + 1
-    start, end = np.concatenate(starts), np.concatenate(ends)
+    if len(runs) == 1:
+        run = runs[0]
+        rows: slice | NDArray[np.int64] = slice(run.first - 1, run.first - 1 + run.count)
+        base: int | NDArray[np.int64] = run.start
+    else:
+        firsts = np.array([run.first - 1 for run in runs], dtype=np.int64)
+        counts = np.array([run.count for run in runs], dtype=np.int64)
+        spans = np.array([run.end - run.start + 1 for run in runs], dtype=np.int64)
+        run_starts = np.array([run.start for run in runs], dtype=np.int64)
+        shifts = np.concatenate([[0], np.cumsum(spans)[:-1]])
+        offsets = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        which = np.repeat(np.arange(len(runs)), counts)
+        rows = firsts[which] + (np.arange(which.shape[0]) - offsets[which])
+        base = (run_starts - shifts)[which]
+    absolute = source.ends[rows]
+    start = source.starts[rows] - base
     buffer = np.frombuffer(source.data, dtype=np.uint8)
-    absolute = np.concatenate([source.ends[r.first - 1 : r.first - 1 + r.count] for r in runs])
-    trailing = end[np.take(buffer, absolute - 1) == 32] - 1
+    trailing = (absolute - base)[np.take(buffer, absolute - 1) == 32] - 1
     return start, trailing
 
 
@@ -391,8 +498,36 @@ def _parse_integers(
     count: int,
     trailing: NDArray[np.int64],
 ) -> NDArray[np.int64]:
-    """A run of integers (numpy's integer parser is faster than JSON's objects)."""
+    """A run of integers (numpy's integer parser is faster than JSON's objects).
+
+    Each keyword and its blank become a marker number (``-9...9``, as wide as the keyword)
+    that numpy reads with the rest: the lines are a rectangle when every row of the result
+    starts with the marker and no other number is the marker (else the blanks of each line
+    are counted instead)."""
     view = np.frombuffer(data, dtype=np.uint8, count=end - start, offset=start)
+    if data.find(b"-", start, end) >= 0:  # numpy reads a lone "-" as 0 and "1-2" as 1, -2
+        minus = np.flatnonzero(view == 45)
+        if minus[-1] + 1 == view.shape[0]:
+            raise BulkParseError
+        digit, before = view[minus + 1], view[minus - 1]
+        if not (((digit >= 48) & (digit <= 57)) & ((before == 32) | (before == 9))).all():
+            raise BulkParseError
+    text = np.frombuffer(bytearray(memoryview(data)[start:end]).translate(_INT_MAP), np.uint8)
+    skip = heads.shape[1]
+    marker = -(10 ** (skip - 2) - 1)
+    text[heads] = np.frombuffer(str(marker).encode() + b" ", dtype=np.uint8)
+    try:
+        array = np.fromstring(text, dtype=np.int64, sep=" ")  # type: ignore[call-overload]
+    except ValueError as exc:  # numpy stopped before the end of the text
+        raise BulkParseError from exc
+    step = array.shape[0] // count
+    if step >= 2 and step * count == array.shape[0]:
+        grid = array.reshape(count, step)
+        if (grid[:, 0] == marker).all() and np.count_nonzero(array == marker) == count:
+            if np.abs(grid[:, 1:]).max() >= _INT_LIMIT:
+                raise BulkParseError  # numpy saturated: let the exact path decide
+            result: NDArray[np.int64] = np.ascontiguousarray(grid[:, 1:])
+            return result
     # A rectangle: as many blanks on every line (a blank ending one aside), hence as many
     # numbers once numpy (which would accept repeated ones) has read the right total.
     is_blank = view == 32
@@ -402,20 +537,9 @@ def _parse_integers(
     width = int(per_line[0])
     if width == 0 or not (per_line == width).all():
         raise BulkParseError
-    if data.find(b"-", start, end) >= 0:  # numpy reads a lone "-" as 0
-        after = np.flatnonzero(view == 45) + 1
-        if after[-1] == view.shape[0]:
-            raise BulkParseError
-        digit = view[after]
-        if not ((digit >= 48) & (digit <= 57)).all():
-            raise BulkParseError
-    text = np.frombuffer(bytearray(memoryview(data)[start:end]).translate(_INT_MAP), np.uint8)
     text[heads] = 32
-    try:
-        array = np.fromstring(text, dtype=np.int64, sep=" ")  # type: ignore[call-overload]
-    except ValueError as exc:  # numpy stopped before the end of the text
-        raise BulkParseError from exc
+    array = np.fromstring(text, dtype=np.int64, sep=" ")  # type: ignore[call-overload]
     if array.shape[0] != count * width or (array.size and np.abs(array).max() >= _INT_LIMIT):
         raise BulkParseError  # a token numpy split or saturated: let the exact path decide
-    result: NDArray[np.int64] = array.reshape(count, width)
+    result = array.reshape(count, width)
     return result

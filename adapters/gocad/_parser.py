@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.adapters.gocad._bodies import read_body
 from geobrep.adapters.gocad._headers import (
     PROPERTY_KEYWORDS,
     PropertyHeader,
@@ -249,6 +250,11 @@ class _Stream:
         item = self.peek()
         self._next = None
         return item
+
+    def skip_to(self, index: int) -> None:
+        """Go on from the 0-based line ``index`` (lines before it were read in bulk)."""
+        self._items = scan(self.source, index)
+        self._next = None
 
 
 def _keyword(text: str) -> str:
@@ -515,6 +521,8 @@ class _Parser:
             if isinstance(item, Run):
                 if vertices is None:
                     vertices, cells = self._tables(obj)
+                    if self._bulk_body(obj, item.first, vertices, cells):
+                        break
                 part = self._run(obj, item, vertices, cells, part, solid)
                 continue
             keyword = _keyword(item.text)
@@ -539,6 +547,8 @@ class _Parser:
                     obj.extra_lines.append(item.text)
                     continue
                 vertices, cells = self._tables(obj)
+                if self._bulk_body(obj, item.number, vertices, cells):
+                    break
             elif self._common(obj, item):
                 self.warn(f"{keyword} after the object's data lines", item.number)
                 continue
@@ -574,6 +584,38 @@ class _Parser:
         # since the vertex table is copied a few times on its way to the properties.
         absent_limit = read_budget(len(self.source.data)) // _ABSENT_SHARE // 8
         return VertexTable(obj.point_header.n_values, absent_limit), cells
+
+    def _bulk_body(
+        self, obj: GocadObject, first: int, vertices: VertexTable, cells: CellTable | None
+    ) -> bool:
+        """The whole body from line ``first`` to its END read in bulk (``_bodies``); False
+        when it is not one the bulk reader takes (nothing is read then)."""
+        limit = vertices.absent_limit
+        body = read_body(
+            self.source,
+            first,
+            obj.type,
+            obj.point_header.n_values,
+            obj.cell_header.n_values,
+            None if limit is None else limit - vertices.absent,
+        )
+        if body is None:
+            return False
+        for keyword, text, line, start in body.parts:
+            obj.declared_parts += 1
+            obj.part_names.append(_unquote(text[len(keyword) :].strip()))
+            obj.part_vertex_starts.append(start)
+            obj.part_lines.append(line)
+        if body.absent_rows:
+            vertices.allow_absent(body.absent_rows)
+        rows = body.vertices
+        vertices.add_rows(rows.ids, rows.xyz, rows.refs, rows.values, rows.flags, rows.lines)
+        if cells is not None and body.cells is not None:
+            cells.add_rows(*body.cells)
+        obj.bstones.extend(body.bstones)
+        obj.borders.extend(body.borders)
+        self.stream.skip_to(body.end + 1)
+        return True
 
     def _check_absent(
         self, obj: GocadObject, vertices: VertexTable, rows: int, keyword: str, line: int

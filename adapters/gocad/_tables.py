@@ -88,6 +88,21 @@ class VertexTable:
             )
         )
 
+    def add_rows(
+        self,
+        ids: IntArray,
+        xyz: FloatArray,
+        refs: IntArray,
+        values: FloatArray,
+        flags: NDArray[np.int8],
+        lines: IntArray,
+    ) -> None:
+        """Vertex lines of every kind in file order (a body read in bulk): ``refs`` -1 but
+        for ATOM / PATOM lines, ``flags`` 64 where an ATOM inherits its vertex's values."""
+        self._flush()
+        if ids.shape[0]:
+            self._chunks.append((ids, xyz, refs, values, flags, lines))
+
     def add_atoms(
         self, ids: IntArray, refs: IntArray, first_line: int, values: FloatArray | None = None
     ) -> None:
@@ -149,9 +164,14 @@ class VertexTable:
         values = np.concatenate([c[3] for c in self._chunks])
         flags = np.concatenate([c[4] for c in self._chunks])
         lines = np.concatenate([c[5] for c in self._chunks])
-        order = np.argsort(ids, kind="stable")
-        sorted_ids = ids[order]
-        repeated = np.flatnonzero(sorted_ids[1:] == sorted_ids[:-1])
+        if bool((ids[1:] > ids[:-1]).all()):  # declared in increasing order: no sort
+            order = np.arange(ids.shape[0], dtype=np.int64)
+            sorted_ids = ids
+            repeated = np.zeros(0, dtype=np.int64)
+        else:
+            order = np.argsort(ids, kind="stable")
+            sorted_ids = ids[order]
+            repeated = np.flatnonzero(sorted_ids[1:] == sorted_ids[:-1])
         if repeated.size:
             first, second = sorted((int(order[repeated[0]]), int(order[repeated[0] + 1])))
             raise error(
@@ -278,6 +298,12 @@ class CellTable:
                 np.arange(first_line, first_line + n, dtype=np.int64),
             )
         )
+
+    def add_rows(self, ids: IntArray, values: FloatArray, parts: IntArray, lines: IntArray) -> None:
+        """Cell lines with their part indices (a body read in bulk)."""
+        self._flush()
+        if ids.shape[0]:
+            self._chunks.append((ids, values, parts, lines))
 
     def _flush(self) -> None:
         if not self._rows:
