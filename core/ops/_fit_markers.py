@@ -28,7 +28,15 @@ if TYPE_CHECKING:
     from geobrep.host.registry import FitterSpec
     from geobrep.ops.fitting import FitResult
 
-__all__ = ["MARKER", "MARKER_WEIGHT", "MarkerPicks", "join_markers", "marker_report", "picks"]
+__all__ = [
+    "MARKER",
+    "MARKER_WEIGHT",
+    "MarkerPicks",
+    "join_markers",
+    "marker_report",
+    "outside_footprint",
+    "picks",
+]
 
 #: Point property flagging the marker points of a joined fit.
 MARKER = "marker"
@@ -138,10 +146,99 @@ def join_markers(
     return joined, updated
 
 
+def _crossings_inside(
+    xy: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64], tolerance: float
+) -> NDArray[np.bool_]:
+    """Even-odd test of points ``(m, 2)`` against the closed boundary edges ``a → b`` (holes
+    and several loops included); points within ``tolerance`` of an edge count as inside."""
+    inside = np.zeros(xy.shape[0], dtype=bool)
+    step = max(1, 4_000_000 // max(a.shape[0], 1))
+    ab = b - a
+    length2 = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
+    for start in range(0, xy.shape[0], step):
+        x = xy[start : start + step, 0][:, None]
+        y = xy[start : start + step, 1][:, None]
+        crosses = (a[None, :, 1] > y) != (b[None, :, 1] > y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            at = a[None, :, 0] + (y - a[None, :, 1]) * ab[None, :, 0] / ab[None, :, 1]
+        odd = (np.count_nonzero(crosses & (x < at), axis=1) % 2) == 1
+        t = np.clip(((x - a[:, 0]) * ab[:, 0] + (y - a[:, 1]) * ab[:, 1]) / length2, 0.0, 1.0)
+        near = np.hypot(a[:, 0] + t * ab[:, 0] - x, a[:, 1] + t * ab[:, 1] - y).min(axis=1)
+        inside[start : start + step] = odd | (near <= tolerance)
+    return inside
+
+
+def _boundary(surface: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """The surface's boundary in map view as edges ``(a, b)``, or None for other entities."""
+    from geobrep.geometry.mesh import boundary_edges
+    from geobrep.geometry.nurbs import surface_points
+    from geobrep.model.entities import NurbsSurface, Surface
+
+    if isinstance(surface, NurbsSurface):
+        net = surface.net
+        (u0, u1), (v0, v1) = net.domain
+        t = np.linspace(0.0, 1.0, 2001)[:-1]
+        u = np.concatenate(
+            [u0 + t * (u1 - u0), np.full(t.size, u1), u1 - t * (u1 - u0), np.full(t.size, u0)]
+        )
+        v = np.concatenate(
+            [np.full(t.size, v0), v0 + t * (v1 - v0), np.full(t.size, v1), v1 - t * (v1 - v0)]
+        )
+        loop = surface_points(net, u, v)[:, :2]
+        return loop, np.roll(loop, -1, axis=0)
+    if isinstance(surface, Surface):
+        vertices = np.asarray(surface.vertices, dtype=np.float64)[:, :2]
+        edges = boundary_edges(surface.faces)
+        return vertices[edges[:, 0]], vertices[edges[:, 1]]
+    return None
+
+
+def outside_footprint(surface: Any, xy: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Which points ``(m, 2)`` lie outside the surface in map view (x, y).
+
+    A triangle mesh covers what its boundary edges enclose; a NURBS surface what its four
+    boundary curves (sampled 2,000 times each) enclose. Points within 10⁻⁶ of the surface's
+    size of the boundary count as inside.
+    """
+    edges = _boundary(surface)
+    points = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
+    if edges is None or edges[0].shape[0] == 0:
+        return np.zeros(points.shape[0], dtype=bool)
+    a, b = edges
+    centre = a.mean(axis=0)
+    size = float(np.ptp(a, axis=0).max()) or 1.0
+    return ~_crossings_inside(points - centre, a - centre, b - centre, 1e-6 * size)
+
+
+def _check_footprint(result: FitResult, found: MarkerPicks) -> None:
+    outside = outside_footprint(result.surface, found.positions[:, :2])
+    if not outside.any():
+        return
+    index = np.flatnonzero(outside)
+    first = found.rows[int(index[0])]
+    x, y = found.positions[index[0], :2]
+    box = result.surface.bounds
+    assert box is not None
+    bounds = np.array([box.mins, box.maxs], dtype=np.float64)
+    raise OptionsError(
+        f"markers: {index.size} marker(s) lie outside the fitted surface in map view, the first "
+        f"{first['marker']!r} of well {first['well']!r} (MD {first['md']:g}) at x = {x:.3f}, "
+        f"y = {y:.3f}; the surface spans x {bounds[0, 0]:.3f} – {bounds[1, 0]:.3f}, "
+        f"y {bounds[0, 1]:.3f} – {bounds[1, 1]:.3f}: widen its domain (the kriging grid's gridx "
+        "and gridy, the boundary curves) or leave that well out"
+    )
+
+
 def marker_report(result: FitResult, found: MarkerPicks, first: int) -> FitResult:
-    """``result`` with the subset ``markers`` (rows ``first:``) and each marker's misfit."""
+    """``result`` with the subset ``markers`` (rows ``first:``) and each marker's misfit.
+
+    Raises:
+        OptionsError: a marker lies outside the fitted surface in map view (its misfit would be
+            the distance to the surface's edge).
+    """
     from geobrep.ops.fitting import SubsetReport
 
+    _check_footprint(result, found)
     distances = result.distances
     report = result.report
     if distances is None or report is None:

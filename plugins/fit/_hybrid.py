@@ -18,7 +18,8 @@ The result is one NurbsSurface: exact on the core, within ε on the rim, gap-fre
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -37,6 +38,7 @@ from geobrep.plugins.fit._approximation import (
     smoothing_weight,
     solve_net,
 )
+from geobrep.plugins.fit._core_correction import correct_core, inside_core, on_core_points
 from geobrep.plugins.fit._domain_map import (
     check_fold_free,
     fill_net,
@@ -322,8 +324,11 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
     )
     hard = np.zeros(points.shape[0], bool) if hard is None else hard
     core_mask = _checked_core_mask(points, frame, options, pointset, hard)
-    core = _skinned_core(points, core_mask, frame, options, (weights, hard))
+    core = _corrected_core(
+        _skinned_core(points, core_mask, frame, options, (weights, hard)), options
+    )
     fitted, layout = _fit_rim(core, options, int((~core_mask).sum()))
+    fitted.details.update(core.details)
     return _hybrid_result(points, pointset, core_mask, core, (fitted, layout), options)
 
 
@@ -338,6 +343,8 @@ class _Core:
     data: _Data
     order: NDArray[np.int64]
     """Input index of each point of ``data`` (skinned core, other core, rim)."""
+    details: dict[str, object] = field(default_factory=dict)
+    """What the correction for points inside the core did (empty when none is inside)."""
 
 
 def _checked_core_mask(
@@ -389,6 +396,43 @@ def _skinned_core(
     rim_weights = None if weights is None else weights[rim_index]
     data = _Data(local[skinned_index], local[exact_index], local[rim_index], rim_weights)
     return _Core(frame, local, skinned, data, order)
+
+
+def _corrected_core(core: _Core, options: HybridOptions) -> _Core:
+    """The core corrected for the exact and rim points that lie inside its patch: hard points
+    are met exactly, rim points fitted by least squares, the skinned points kept (see
+    :mod:`~geobrep.plugins.fit._core_correction`)."""
+    data = core.data
+    exact_in, exact_params = inside_core(core.skinned, data.exact)
+    rim_in, rim_params = inside_core(core.skinned, data.rim)
+    world = core.frame.to_world(data.skinned)
+    exact_in[exact_in] &= ~on_core_points(
+        world, core.frame.to_world(data.exact[exact_in]), np.ones(int(exact_in.sum()), bool), LABEL
+    )
+    rim_in[rim_in] &= ~on_core_points(
+        world, core.frame.to_world(data.rim[rim_in]), np.zeros(int(rim_in.sum()), bool), LABEL
+    )
+    if not (exact_in.any() or rim_in.any()):
+        return core
+    n_exact = int(exact_in.sum())
+    weights = None
+    if data.rim_weights is not None:
+        weights = np.r_[np.ones(n_exact), data.rim_weights[rim_in]]
+    correction = correct_core(
+        core.skinned,
+        np.concatenate([exact_params[exact_in], rim_params[rim_in]]),
+        np.concatenate([data.exact[exact_in, 2], data.rim[rim_in, 2]]),
+        np.r_[np.ones(n_exact, bool), np.zeros(int(rim_in.sum()), bool)],
+        weights,
+        options.smoothing,
+        LABEL,
+    )
+    details: dict[str, object] = {
+        "core_points_corrected": {"exact": n_exact, "least_squares": int(rim_in.sum())},
+        "core_knots_inserted": list(correction.inserted),
+        "core_max_height_change": correction.max_correction,
+    }
+    return dataclasses.replace(core, skinned=correction.skinned, details=details)
 
 
 _Rectangle = tuple[float, float, float, float]

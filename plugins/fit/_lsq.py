@@ -86,6 +86,29 @@ def _factor_spd(matrix: sp.csr_matrix, what: str) -> Callable[[FloatArray], Floa
     return solve
 
 
+def _drop_met(
+    a_free: sp.csr_matrix, t: FloatArray, targets: FloatArray, what: str
+) -> tuple[sp.csr_matrix, FloatArray]:
+    """The exact conditions that involve a free control point; the others must already hold.
+
+    A point whose control points are all held fixed (inside a fixed block, such as a skinned
+    core that was corrected to pass through it) constrains nothing, and is met or contradicts.
+    """
+    involved = np.asarray(abs(a_free).sum(axis=1)).ravel() > 0
+    if bool(involved.all()):
+        return a_free, t
+    tolerance = 1e-6 * max(1.0, float(np.abs(targets).max(initial=0.0)))
+    miss = np.abs(t[~involved]).max(initial=0.0)
+    if miss > tolerance:
+        rows = np.flatnonzero(~involved)
+        raise DegenerateGeometryError(
+            f"{what}: {rows.size} point(s) to interpolate exactly (the first is exact point "
+            f"{int(rows[0])}) depend only on fixed control points, which miss them by up to "
+            f"{miss:.3g}; give them as free data or fix fewer control points"
+        )
+    return sp.csr_matrix(a_free[involved]), t[involved]
+
+
 def solve_penalised(
     normal: sp.csr_matrix,
     rhs: FloatArray,
@@ -131,10 +154,13 @@ def solve_penalised(
     if equality is not None and equality[0].shape[0]:
         a_all, targets = equality
         a_all = sp.csr_matrix(a_all)
-        a_free = a_all[:, free]
         t = targets.reshape(targets.shape[0], -1) - (
             a_all[:, fixed_index] @ known if fixed_index.size else 0.0
         )
+        a_free, t = _drop_met(a_all[:, free], t, targets, what)
+        if a_free.shape[0] == 0:
+            solution[free] = free_solution
+            return solution
         y_mat = solve(a_free.T.toarray())  # (n_free, k)
         schur = np.asarray(a_free @ y_mat)
         try:

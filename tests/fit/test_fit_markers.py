@@ -13,7 +13,7 @@ import geobrep
 from geobrep import Well, WellMarker
 from geobrep.cli import main
 from geobrep.datasets.scattered import dome_elevation
-from geobrep.errors import OptionsError
+from geobrep.errors import DegenerateGeometryError, OptionsError
 from geobrep.geometry.trajectory import minimum_curvature
 
 ORIGIN = np.array([450_000.0, 6_700_000.0, 0.0])
@@ -55,10 +55,10 @@ def test_markers_sit_on_the_true_surface() -> None:
         assert abs(position[0, 2] - _true_z(position)[0]) < 1e-6
 
 
-def _markers(result: geobrep.FitResult) -> list[float]:
+def _markers(result: geobrep.FitResult, n: int = len(WELLS)) -> list[float]:
     report = result.report
     assert report is not None
-    assert report.subsets["markers"].n == len(WELLS)
+    assert report.subsets["markers"].n == n
     distances = [row["distance"] for row in report.details["markers"]]
     assert report.subsets["markers"].max_abs == pytest.approx(max(abs(d) for d in distances))
     return distances
@@ -144,3 +144,124 @@ def test_cli_fit_takes_well_files(tmp_path: Path, capsys: pytest.CaptureFixture[
     report = json.loads(capsys.readouterr().out)["report"]
     assert report["subsets"]["markers"]["n"] == 3
     assert report["subsets"]["markers"]["max_abs"] < 1e-6
+
+
+CORE_WELLS = [
+    deviated_well("C1", (400.0, 420.0), 45.0),
+    deviated_well("C2", (560.0, 520.0), 200.0),
+]
+MIXED_WELLS = [*CORE_WELLS, WELLS[0]]  # two markers inside the skinned core, one in the rim
+
+
+def _written_misfit(result: geobrep.FitResult, path: Path, wells: list[Well]) -> np.ndarray:
+    """Marker distances measured on the surface as written to and read back from ``path``."""
+    from geobrep.plugins.fit.distance import surface_distances
+
+    result.write(path)
+    (surface,) = geobrep.read(path).entities
+    assert isinstance(surface, geobrep.NurbsSurface)
+    where = np.concatenate([w.marker_positions()[:1] for w in wells])
+    return np.asarray(surface_distances(surface, where))
+
+
+@pytest.mark.parametrize("core", [{"core_property": "core"}, {}], ids=["flagged", "density"])
+def test_hybrid_meets_hard_markers_in_the_core_and_the_rim(
+    core: dict[str, str], tmp_path: Path
+) -> None:
+    points = geobrep.datasets.scattered_points()
+    plain = geobrep.fit(points, method="hybrid", epsilon=0.5, **core)
+    result = geobrep.fit(points, method="hybrid", epsilon=0.5, markers=MIXED_WELLS,
+                         marker_surface="dome", marker_weight="hard", **core)  # fmt: skip
+    report = result.report
+    assert report is not None
+    assert report.passed
+    assert report.subsets["markers"].n == 3
+    assert report.subsets["markers"].max_abs < 1e-6
+    assert np.abs(_written_misfit(result, tmp_path / "top.geobrep", MIXED_WELLS)).max() < 1e-6
+    # without the correction the surface misses the core markers by centimetres
+    from geobrep.plugins.fit.distance import surface_distances
+
+    where = np.concatenate([w.marker_positions()[:1] for w in CORE_WELLS])
+    assert np.abs(surface_distances(plain.surface, where)).max() > 1e-3
+    # the skinned core is still interpolated exactly, and joins the rim without a gap
+    assert report.subsets["core"].max_abs < 1e-6
+    assert report.seam_gap is not None
+    assert report.seam_gap < 1e-6
+    assert report.details["core_points_corrected"]["exact"] == 2
+    # the correction is local: far from the markers the core surface does not move (the grid
+    # stays inside the skinned rows; the rim beyond them is fitted anew)
+    g = np.linspace(340.0, 630.0, 30)
+    grid = np.column_stack([np.repeat(g, g.size), np.tile(g, g.size), np.zeros(g.size**2)])
+    grid += ORIGIN
+    grid[:, 2] = _true_z(grid)
+    change = np.abs(
+        surface_distances(result.surface, grid) - surface_distances(plain.surface, grid)
+    )
+    far = np.min(np.linalg.norm(grid[:, None, :2] - where[None, :, :2], axis=2), axis=1) > 100.0
+    assert change[far].max() < 2e-3 < change.max()
+
+
+def test_hybrid_soft_markers_in_the_core_and_the_rim_reduce_the_misfit() -> None:
+    from geobrep.plugins.fit.distance import surface_distances
+
+    points = geobrep.datasets.scattered_points()
+    where = np.concatenate([w.marker_positions()[:1] for w in MIXED_WELLS])
+    plain = geobrep.fit(points, method="hybrid", epsilon=0.5, core_property="core")
+    without = np.abs(surface_distances(plain.surface, where))
+    misfits = {}
+    for weight in (1.0, 100.0):
+        result = geobrep.fit(points, method="hybrid", epsilon=0.5, core_property="core",
+                             markers=MIXED_WELLS, marker_surface="dome",
+                             marker_weight=weight)  # fmt: skip
+        assert result.report is not None
+        assert result.report.passed
+        assert result.report.subsets["core"].max_abs < 1e-6
+        misfits[weight] = np.abs(_markers(result, len(MIXED_WELLS)))
+    assert np.all(misfits[1.0] < without)
+    assert np.all(misfits[100.0] < misfits[1.0])
+    assert misfits[100.0][:2].max() < 1e-5  # inside the core nothing competes with them
+
+
+def test_a_hard_marker_on_a_core_point_at_another_height_is_a_clear_error() -> None:
+    points = geobrep.datasets.scattered_points()
+    core = points.vertices[points.point_data["core"].values == 1]
+    target = core[np.argmin(np.linalg.norm(core[:, :2] - core[:, :2].mean(axis=0), axis=1))]
+    head = target + np.array([0.0, 0.0, 50.0])
+    well = Well(name="V", head=head, vertices=[head, head - [0.0, 0.0, 100.0]], md=[0.0, 100.0],
+                markers=[WellMarker(name="top", md=49.0, surface="dome")])  # fmt: skip
+    with pytest.raises(DegenerateGeometryError, match="inside the skinned core cannot be met"):
+        geobrep.fit(points, method="hybrid", core_property="core", markers=[well],
+                    marker_weight="hard")  # fmt: skip
+
+
+def test_a_marker_outside_the_fitted_surface_is_a_clear_error() -> None:
+    points = geobrep.datasets.scattered_points(n_core=100, n_rim=100)
+    far = deviated_well("F", (1500.0, 400.0), 45.0)
+    lo, hi = points.vertices[:, :2].min(axis=0), points.vertices[:, :2].max(axis=0)
+    grid = {"gridx": np.linspace(lo[0], hi[0], 20).tolist(),
+            "gridy": np.linspace(lo[1], hi[1], 20).tolist()}  # fmt: skip
+    with pytest.raises(OptionsError, match=r"map view, the first 'F H' of well 'F'"):
+        geobrep.fit(points, method="kriging", markers=[far], marker_surface="dome", **grid)
+    inside = geobrep.fit(points, method="kriging", markers=WELLS, marker_surface="dome", **grid)
+    assert inside.report is not None
+    assert inside.report.subsets["markers"].n == 3
+
+
+def test_exact_points_on_fixed_control_points_are_checked_not_solved() -> None:
+    import scipy.sparse as sp
+
+    from geobrep.plugins.fit._lsq import solve_penalised
+
+    normal = sp.csr_matrix(np.eye(3))
+    rhs = np.array([[1.0], [2.0], [3.0]])
+    fixed = np.array([True, False, False])
+    values = np.array([[5.0], [0.0], [0.0]])
+    # the first exact point depends on the fixed control point only and is met by it
+    rows = sp.csr_matrix(np.array([[1.0, 0.0, 0.0], [0.0, 0.5, 0.5]]))
+    solution = solve_penalised(normal, rhs, fixed=fixed, fixed_values=values,
+                               equality=(rows, np.array([5.0, 4.0])))  # fmt: skip
+    assert solution[0, 0] == 5.0
+    assert solution[1:, 0] @ [0.5, 0.5] == pytest.approx(4.0)
+    with pytest.raises(DegenerateGeometryError, match="depend only on fixed control points"):
+        solve_penalised(normal, rhs, fixed=fixed, fixed_values=values,
+                        equality=(rows, np.array([6.0, 4.0])))  # fmt: skip
