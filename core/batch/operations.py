@@ -35,9 +35,9 @@ from geobrep.batch.pipeline import (
     ViewStep,
     VoxelizeStep,
 )
-from geobrep.errors import EntityNotFoundError, OptionsError
+from geobrep.errors import EntityNotFoundError, FileAccessError, FormatError, OptionsError
 from geobrep.host.operations import OperationRegistry, OperationSpec, options_table
-from geobrep.model.entities import Entity, PointSet, PolyLine
+from geobrep.model.entities import Entity, PointSet, PolyLine, Well
 from geobrep.model.scene import Scene
 
 __all__ = [
@@ -45,8 +45,11 @@ __all__ = [
     "builtin_operations",
     "docs_tables",
     "fit_inputs",
+    "fit_markers",
+    "fit_points",
     "map_scene_products",
     "operations",
+    "read_wells",
     "update_docs",
 ]
 
@@ -107,14 +110,69 @@ def fit_inputs(scene: Scene, names: Sequence[str] | None) -> list[PointSet | Pol
     return points
 
 
+def read_wells(paths: Sequence[str], folder: Path | None = None) -> list[Well]:
+    """The wells of the files ``paths`` (any readable format: GOCAD ``.wl``, deviation tables,
+    ``.geobrep``, ...), in order: what a fit's ``markers`` name.
+
+    With ``folder`` (a pipeline's), each path is relative to it and must stay in it: no
+    absolute path, no ``..`` part, and the file must resolve (symlinks followed) inside
+    ``folder``. Without, paths are taken as given (the command line's).
+
+    Raises:
+        FileAccessError: a file is missing, or outside ``folder``.
+        FormatError: a file holds no well (or cannot be read).
+    """
+    from geobrep.batch.pipeline import confinement_problem
+    from geobrep.ops.io import read
+
+    wells: list[Well] = []
+    for name in paths:
+        path = Path(name)
+        if folder is not None:
+            problem = confinement_problem(str(name))
+            if problem:
+                raise FileAccessError(f"well file {problem}", path)
+            path = folder / path
+            inside = folder.resolve()
+            if path.exists() and not path.resolve().is_relative_to(inside):
+                raise FileAccessError(
+                    f"well file resolves to {path.resolve()}, outside the pipeline's folder "
+                    f"{folder}; a step reads files in it only",
+                    path,
+                )
+        if not path.is_file():
+            raise FileAccessError("no such well file" if not path.exists() else "not a file", path)
+        found = read(path).wells
+        if not found:
+            raise FormatError("the file holds no well (markers need wells)", path)
+        wells.extend(found)
+    return wells
+
+
+def fit_markers(step: FitStep, folder: Path | None) -> dict[str, Any]:
+    """The keywords of :func:`geobrep.fit` that a fit step's ``markers`` options give (the
+    wells read from ``folder``, see :func:`read_wells`); empty without markers."""
+    if step.markers is None:
+        return {}
+    return {
+        "markers": read_wells(step.markers, folder),
+        "marker_surface": step.marker_surface,
+        "marker_weight": step.marker_weight,
+    }
+
+
 def fit_points(scene: Scene, step: FitStep) -> Scene:
-    """The surfaces fitted to the scene's PointSets (or the entities ``step.points`` names)."""
+    """The surfaces fitted to the scene's PointSets (or the entities ``step.points`` names);
+    ``step.markers`` are read relative to, and inside, the working folder."""
     from geobrep.ops.fitting import fit
 
     points = fit_inputs(scene, step.points)
     options: dict[str, Any] = dict(step.options)
+    markers = fit_markers(step, Path.cwd())
     surfaces: list[Entity] = [
-        fit(entity, method=step.method, **options).surface.model_copy(update={"id": None})
+        fit(entity, method=step.method, **markers, **options).surface.model_copy(
+            update={"id": None}
+        )
         for entity in points
     ]
     if step.keep_input:

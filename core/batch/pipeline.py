@@ -34,7 +34,7 @@ import argparse
 import json
 from collections.abc import Mapping
 from os import PathLike
-from pathlib import Path
+from pathlib import Path, PureWindowsPath
 from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal, Union
 
 from pydantic import (
@@ -91,6 +91,7 @@ __all__ = [
     "ViewStep",
     "VoxelizeStep",
     "WriteStep",
+    "confinement_problem",
     "option_names",
 ]
 
@@ -256,6 +257,26 @@ def _one_name(text: str) -> tuple[str]:
     return (text,)
 
 
+def confinement_problem(name: str) -> str | None:
+    """Why a file a pipeline step reads may lie outside the pipeline's folder (None: it may
+    not). Such paths are relative, with no ``..`` part; symlinks are checked when it is read."""
+    if not name or PureWindowsPath(name).anchor or Path(name).is_absolute():
+        return "is not a path relative to the pipeline's folder (a step reads files in it only)"
+    if ".." in PureWindowsPath(name).parts:
+        return "leaves the pipeline's folder (a step reads files in it only; no '..')"
+    return None
+
+
+def _marker_weight(text: str) -> float | str:
+    """``--marker-weight``: a number, or ``hard``."""
+    if text == "hard":
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise OptionsError(f"--marker-weight: expected a number or 'hard', got {text!r}") from None
+
+
 class FitStep(StepOptions):
     """Fit a surface to each PointSet (or to the entities named in ``points``) with the
     fitter ``method``; ``options`` are the fitter's (e.g. ``epsilon``). The scene becomes the
@@ -287,8 +308,33 @@ class FitStep(StepOptions):
     max_triangles: Annotated[int, Cli(metavar="N")] = Field(default=1_000_000, ge=2)
     """bound on the mesh written of each fitted NURBS surface when the format cannot hold NURBS
     (default 1000000)"""
+    markers: Annotated[tuple[str, ...] | None, Cli(nargs="+", metavar="WELLFILE")] = Field(
+        default=None, min_length=1
+    )
+    """well files whose markers join the points (in a pipeline: relative to its folder and
+    inside it)"""
+    marker_surface: Annotated[str | None, Cli(metavar="NAME")] = None
+    """the surface the markers must name (needed when they name several)"""
+    marker_weight: Annotated[
+        Annotated[FiniteFloat, Field(ge=0)] | Literal["hard"] | None,
+        Cli(parse=_marker_weight, metavar="W|hard"),
+    ] = None
+    """weight of the markers in a least-squares fit, or 'hard': the surface passes through them"""
 
     model_config = ConfigDict(populate_by_name=True)
+
+    @field_validator("markers", mode="before")
+    @classmethod
+    def _one_well_file(cls, value: Any) -> Any:
+        return [value] if isinstance(value, str | PathLike) else value
+
+    @model_validator(mode="after")
+    def _markers_given(self) -> FitStep:
+        if self.markers is None and (
+            self.marker_surface is not None or self.marker_weight is not None
+        ):
+            raise ValueError("marker_surface and marker_weight need markers (the well files)")
+        return self
 
     def check(self, registries: Registries) -> None:
         _get(registries.fitters, self.method, "method").validate_options(self.options)
@@ -915,6 +961,12 @@ class Pipeline(BaseModel):
             )
         if not any(isinstance(step, OutputStep) for step in self.step_list):
             raise ValueError("the pipeline writes nothing: add a write step")
+        for number, step in enumerate(self.step_list, 1):
+            if isinstance(step, FitStep):
+                for name in step.markers or ():
+                    problem = confinement_problem(name)
+                    if problem:
+                        raise ValueError(f"step {number} (fit): markers: {name!r} {problem}")
         return self
 
     # -- access ---------------------------------------------------------------------------------
@@ -1139,8 +1191,10 @@ def _describe(exc: ValidationError, data: Mapping[str, Any]) -> str:
 def option_names(step_type: type[StepOptions]) -> list[str]:
     """The keys a step body takes (aliases where a field has one), in declaration order.
 
-    >>> option_names(FitStep)
+    >>> option_names(FitStep)[:6]
     ['method', 'points', 'options', 'keep_input', 'check', 'max_triangles']
+    >>> option_names(FitStep)[6:]
+    ['markers', 'marker_surface', 'marker_weight']
     """
     return [info.alias or name for name, info in step_type.model_fields.items()]
 

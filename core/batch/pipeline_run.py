@@ -254,6 +254,8 @@ class _Work:
     source: Path
     targets: tuple[Path, ...]
     registries: Registries
+    folder: Path = field(default_factory=Path.cwd)
+    """The pipeline's folder: the files a step reads (a fit's well files) are in it."""
     contain: bool = True
     """Check that each output still resolves inside its folder right before writing it."""
     number: int = 0
@@ -291,7 +293,13 @@ def run_steps(
     numbered: list[tuple[int, StepOptions]] = list(enumerate(bodies, 1))
     if not isinstance(bodies[0], ReadStep):
         numbered.insert(0, (0, ReadStep()))
-    work = _Work(source=source, targets=targets, registries=registries(), contain=contain)
+    work = _Work(
+        source=source,
+        targets=targets,
+        registries=registries(),
+        folder=pipeline.base_dir or Path.cwd(),
+        contain=contain,
+    )
     try:
         branches: list[tuple[str, Scene]] = [("", _nothing_read())]
         for work.number, body in numbered:
@@ -443,15 +451,16 @@ def _section(step: SectionStep, scene: Scene, work: _Work) -> Applied:
 
 
 def _fit(step: FitStep, scene: Scene, work: _Work) -> Applied:
-    from geobrep.batch.operations import fit_inputs
+    from geobrep.batch.operations import fit_inputs, fit_markers
     from geobrep.ops.fitting import fit
 
     points = fit_inputs(scene, step.points)
+    markers = fit_markers(step, work.folder)
     surfaces: list[Entity] = []
     notes: list[str] = []
     for entity in points:
         options: dict[str, Any] = dict(step.options)
-        result = fit(entity, method=step.method, **options)
+        result = fit(entity, method=step.method, **markers, **options)
         label = entity.name or entity.label
         report = result.report
         if report is None:
@@ -462,6 +471,12 @@ def _fit(step: FitStep, scene: Scene, work: _Work) -> Applied:
                 f"{label}: {step.method} σ = {report.sigma:.4g}, max |d| = "
                 f"{report.max_abs:.4g}, n = {report.n} ({verdict})"
             )
+            if "markers" in report.subsets:
+                found = report.subsets["markers"]
+                notes.append(
+                    f"{label}: {found.n} well marker(s), σ = {found.sigma:.4g}, max |d| = "
+                    f"{found.max_abs:.4g}"
+                )
             if step.check_epsilon and report.passed is False:
                 raise OptionsError(
                     f"the {step.method} fit of {label!r} does not meet ε = {report.epsilon:g} "

@@ -11,8 +11,9 @@ report then gives the accuracy of both, and ``--check`` judges the mesh, the obj
     geobrep fit survey.csv top.geobrep --markers w1.wl w2.dev --marker-surface Top \\
         --marker-weight hard
 
-``--markers`` reads wells from any readable files (GOCAD .wl, deviation tables, .geobrep...); their
-markers that name ``--marker-surface`` join the points (see :func:`geobrep.fit`).
+``--markers`` reads wells from any readable files (GOCAD .wl, deviation tables, .geobrep...; the
+reader a pipeline's fit step shares, :func:`geobrep.batch.operations.read_wells`); their markers
+that name ``--marker-surface`` join the points (see :func:`geobrep.fit`).
 """
 
 from __future__ import annotations
@@ -23,26 +24,18 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict
 
+from geobrep.batch.operations import fit_markers
 from geobrep.batch.pipeline import FitStep
 from geobrep.cli.common import format_name
 from geobrep.errors import FileAccessError, FormatError, OptionsError
 from geobrep.host.operations import Cli
-from geobrep.model.entities import Entity, PointSet, PolyLine, Well
+from geobrep.model.entities import Entity, PointSet, PolyLine
 
 __all__ = ["COMMAND", "DESCRIPTION", "EXIT_NOT_MET", "OPERATION", "FitCommand", "run"]
 
 OPERATION = "fit"
 DESCRIPTION = "Fit a surface to points and report σ, max |d| and n per subset against ε."
 EXIT_NOT_MET = 3
-
-
-def _weight(text: str) -> float | str:
-    if text == "hard":
-        return text
-    try:
-        return float(text)
-    except ValueError:
-        raise OptionsError(f"--marker-weight: expected a number or 'hard', got {text!r}") from None
 
 
 class FitCommand(BaseModel):
@@ -62,12 +55,6 @@ class FitCommand(BaseModel):
     """also write the report as JSON to this file"""
     as_json: Annotated[bool, Cli(flags=("--json",))] = False
     """print the report as JSON"""
-    markers: Annotated[tuple[str, ...] | None, Cli(nargs="+", metavar="WELLFILE")] = None
-    """well files whose markers join the points"""
-    marker_surface: Annotated[str | None, Cli(metavar="NAME")] = None
-    """the surface the markers must name (needed when they name several)"""
-    marker_weight: Annotated[float | str | None, Cli(parse=_weight, metavar="W|hard")] = None
-    """weight of the markers in a least-squares fit, or 'hard': the surface passes through them"""
 
 
 def _load_points(path: Path, fmt: str | None, entity: str | None) -> PointSet | PolyLine:
@@ -90,21 +77,6 @@ def _load_points(path: Path, fmt: str | None, entity: str | None) -> PointSet | 
     return chosen
 
 
-def _load_wells(paths: tuple[str, ...], fmt: str | None) -> list[Well]:
-    from geobrep.ops.io import read
-
-    wells: list[Well] = []
-    for name in paths:
-        path = Path(name)
-        if not path.exists():
-            raise FileAccessError("no such file", path)
-        found = read(path).wells
-        if not found:
-            raise FormatError("the file holds no well", path)
-        wells.extend(found)
-    return wells
-
-
 def run(step: FitStep, args: FitCommand) -> int:
     from geobrep.ops.fitting import fit
     from geobrep.ops.io import atomic_write
@@ -114,15 +86,7 @@ def run(step: FitStep, args: FitCommand) -> int:
     options: dict[str, Any] = dict(step.options)
     if args.epsilon is not None:
         options["epsilon"] = args.epsilon
-    markers = _load_wells(args.markers, args.format) if args.markers else None
-    result = fit(
-        points,
-        method=step.method,
-        markers=markers,
-        marker_surface=args.marker_surface,
-        marker_weight=args.marker_weight,
-        **options,
-    )
+    result = fit(points, method=step.method, **fit_markers(step, None), **options)
     out = Path(args.out)
     result = result.write(out, max_triangles=step.max_triangles)
     report = result.report
