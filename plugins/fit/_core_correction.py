@@ -57,15 +57,28 @@ class CoreCorrection:
 
 def inside_core(skinned: SkinnedNet, local: FloatArray) -> tuple[NDArray[np.bool_], FloatArray]:
     """Which points ``(m, 3)`` lie over the core's patch, and their core parameters ``(m, 2)``."""
-    if local.shape[0] == 0:
-        return np.zeros(0, bool), np.zeros((0, 2))
     net = skinned.net
+    xy = net.control_points[..., :2].reshape(-1, 2)
+    scale = float(np.ptp(xy, axis=0).max()) if xy.size else 1.0
+    inside = np.zeros(local.shape[0], dtype=bool)
+    params = np.zeros((local.shape[0], 2))
+    # the patch lies in the convex hull of its control points: only points in their box can be on it
+    margin = 1e-9 * (scale or 1.0)
+    near = np.flatnonzero(
+        np.all(
+            (local[:, :2] >= xy.min(axis=0) - margin) & (local[:, :2] <= xy.max(axis=0) + margin),
+            axis=1,
+        )
+    )
+    if near.size == 0:
+        return inside, params
     flat = planar_map(
         (net.degree_u, net.degree_v), (net.knots_u, net.knots_v), net.control_points[..., :2]
     )
-    u, v, residual = invert_planar_map(flat, local[:, :2])
-    scale = float(np.ptp(net.control_points[..., :2].reshape(-1, 2), axis=0).max()) or 1.0
-    return residual <= 1e-9 * scale, np.column_stack([u, v])
+    u, v, residual = invert_planar_map(flat, local[near, :2])
+    inside[near] = residual <= 1e-9 * (scale or 1.0)
+    params[near] = np.column_stack([u, v])
+    return inside, params
 
 
 def _new_knots(knots: FloatArray, degree: int, params: FloatArray) -> FloatArray:
