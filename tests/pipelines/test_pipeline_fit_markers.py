@@ -180,3 +180,19 @@ def test_the_fit_operation_reads_markers_from_the_working_folder(
     assert _misfit(surface, project).max() < 1e-6
     with pytest.raises(FileAccessError, match="leaves the pipeline's folder"):
         operations().get("fit")(scene, markers=["../W1.wl"], marker_surface="dome")
+
+
+def test_worker_processes_find_the_well_files(
+    project: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    geobrep.write(geobrep.datasets.scattered_points(seed=1), project / "points_b.geobrep")
+    path = _pipeline(project)
+    path.write_text(
+        path.read_text(encoding="utf-8").replace("[points.geobrep]", "[points*.geobrep]"),
+        encoding="utf-8",
+    )
+    summary = geobrep.run_pipeline(path, jobs=2)
+    assert summary.ok, summary.table()
+    for name in ("points_top.geobrep", "points_b_top.geobrep"):
+        assert _misfit(_surface(project / "out" / name), project).max() < 1e-6
