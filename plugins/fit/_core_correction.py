@@ -5,8 +5,9 @@ point but lies inside the core's patch (a well marker, hard data, a rim point in
 outline) cannot pull it. The correction gives the net that freedom and uses it without moving a
 skinned point:
 
-1. knots are inserted at the points' core parameters (in u and in v; the surface is unchanged), so
-   the refined space holds splines that vanish at every skinned point but not at these points;
+1. knots are inserted at the points' core parameters and at the midpoints of the knot spans
+   about them (in u and in v; the surface is unchanged), so the refined space holds splines that
+   vanish at every skinned point but not at these points;
 2. a height correction ``δ`` on the refined net minimises ``λ · E(δ) + Σ wᵢ (δ(uᵢ, vᵢ) − rᵢ)²``
    (``E`` the bending energy, ``rᵢ`` the height misfit of the soft points) subject to
    ``δ = 0`` at every skinned point and ``δ = rⱼ`` at the hard points, solved as one sparse KKT
@@ -53,6 +54,8 @@ class CoreCorrection:
     """Knots inserted in u and in v."""
     max_correction: float
     """Largest height change of a control point."""
+    max_misfit: float = 0.0
+    """Largest height misfit of the points before the correction."""
 
 
 def inside_core(skinned: SkinnedNet, local: FloatArray) -> tuple[NDArray[np.bool_], FloatArray]:
@@ -81,8 +84,19 @@ def inside_core(skinned: SkinnedNet, local: FloatArray) -> tuple[NDArray[np.bool
     return inside, params
 
 
+#: Spans on either side of a point's span that are halved as well (the correction's room).
+NEIGHBOUR_SPANS = 1
+
+
 def _new_knots(knots: FloatArray, degree: int, params: FloatArray) -> FloatArray:
-    """Distinct interior parameters that are not knots already (one per cluster)."""
+    """The points' parameters and the midpoints of the spans about them, unless knots already
+    (one per cluster)."""
+    breaks = np.unique(knots)
+    span = np.clip(np.searchsorted(breaks, params, side="right") - 1, 0, breaks.size - 2)
+    offsets = np.arange(-NEIGHBOUR_SPANS, NEIGHBOUR_SPANS + 1)
+    around = np.unique(np.clip(span[:, None] + offsets[None, :], 0, breaks.size - 2))
+    midpoints = 0.5 * (breaks[around] + breaks[around + 1])
+    params = np.concatenate([params, midpoints])
     inner = np.sort(params[(params > knots[degree]) & (params < knots[-degree - 1])])
     if inner.size == 0:
         return inner
@@ -211,4 +225,5 @@ def correct_core(
         SkinnedNet(corrected, skinned.row_parameters, skinned.section_parameters),
         (nu - net.shape[0], nv - net.shape[1]),
         float(np.abs(delta).max(initial=0.0)),
+        float(np.abs(misfit).max(initial=0.0)),
     )

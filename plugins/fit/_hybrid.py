@@ -432,6 +432,12 @@ def _corrected_core(core: _Core, options: HybridOptions) -> _Core:
         "core_knots_inserted": list(correction.inserted),
         "core_max_height_change": correction.max_correction,
     }
+    if correction.max_correction > 8.0 * correction.max_misfit:  # about 3x for isolated points
+        details["core_correction_note"] = (
+            f"the core moved by up to {correction.max_correction:.3g} to meet points it missed by "
+            f"at most {correction.max_misfit:.3g}: a point close to a core point at a height "
+            "that does not follow the core's slope"
+        )
     return dataclasses.replace(core, skinned=correction.skinned, details=details)
 
 
@@ -516,6 +522,9 @@ def _hybrid_result(
     inverse[core.order] = np.arange(core.order.shape[0])
     distances = surface_distances(surface, points, fitted.u[inverse], fitted.v[inverse])
     notes = list(fitted.notes)
+    details = dict(fitted.details)
+    if "core_correction_note" in details:
+        notes.append(str(details.pop("core_correction_note")))
     rim_sigma = sigma(distances[~core_mask])
     if options.epsilon is not None and not rim_sigma < options.epsilon:
         nu, nv = fitted.net.shape
@@ -533,7 +542,7 @@ def _hybrid_result(
         labels=np.where(core_mask, "core", "rim"),
         seam_gap=gap,
         notes=notes,
-        details=fitted.details,
+        details=details,
     )
     return FitResult(
         surface=surface,

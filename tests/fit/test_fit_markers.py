@@ -265,3 +265,24 @@ def test_exact_points_on_fixed_control_points_are_checked_not_solved() -> None:
     with pytest.raises(DegenerateGeometryError, match="depend only on fixed control points"):
         solve_penalised(normal, rhs, fixed=fixed, fixed_values=values,
                         equality=(rows, np.array([6.0, 4.0])))  # fmt: skip
+
+
+def test_a_marker_beside_a_core_point_off_its_slope_is_met_and_noted() -> None:
+    points = geobrep.datasets.scattered_points()
+    core = points.vertices[points.point_data["core"].values == 1]
+    target = core[np.argmin(np.linalg.norm(core[:, :2] - core[:, :2].mean(axis=0), axis=1))]
+    head = target + np.array([0.5, 0.0, 50.01])  # 0.5 m beside it, 1 cm above it
+    well = Well(name="V", head=head, vertices=[head, head - [0.0, 0.0, 100.0]], md=[0.0, 100.0],
+                markers=[WellMarker(name="top", md=50.0, surface="dome")])  # fmt: skip
+    result = geobrep.fit(points, method="hybrid", epsilon=0.5, core_property="core",
+                         markers=[well], marker_weight="hard")  # fmt: skip
+    report = result.report
+    assert report is not None
+    assert report.subsets["markers"].max_abs < 1e-6
+    assert report.subsets["core"].max_abs < 1e-6
+    assert any("does not follow the core's slope" in note for note in report.notes)
+    benign = geobrep.fit(points, method="hybrid", epsilon=0.5, core_property="core",
+                         markers=CORE_WELLS, marker_surface="dome",
+                         marker_weight="hard")  # fmt: skip
+    assert benign.report is not None
+    assert not any("core's slope" in note for note in benign.report.notes)
