@@ -63,6 +63,12 @@ _KEEP = np.array(
     [0] + [(0xFFFFFFFFFFFFFFFF << (8 * (8 - r))) & 0xFFFFFFFFFFFFFFFF for r in range(1, 9)],
     dtype=_U64,
 )
+_U32 = np.uint32
+_ZEROS32 = _U32(0x30303030)
+_NOT_DIGIT32 = _U32(0x76767676)
+_PAIRS32 = _U32(0x00FF00FF)
+_MUL32 = _U32(0x00640001)  # 1 + (100 << 16)
+_KEEP32 = np.array([0] + [(0xFFFFFFFF << (8 * (4 - r))) & 0xFFFFFFFF for r in range(1, 5)], _U32)
 _POW10_U64 = np.array([10**k for k in range(20)], dtype=_U64)
 _MAX_EXP10 = 27  # 5**27 < 2**64: 10**27 is exact in a 64-bit significand
 #: The x87 80-bit extended format (64-bit significand, stored in 16 little-endian bytes).
@@ -454,6 +460,37 @@ def _eight(
     return word, bad
 
 
+def _four(
+    data: NDArray[np.uint8], last: IntArray, length: IntArray
+) -> tuple[NDArray[np.uint32], NDArray[np.uint32]]:
+    """:func:`_eight` for runs of 0 to 4 digits (I J K indices, the integer part of most
+    values), in 4-byte words: half the memory traffic and twice the lanes."""
+    words = data.view("<u4")
+    q = last >> 2
+    shift = last & 3
+    shift <<= 3
+    right = shift.astype(_U32)
+    left = _U32(32) - right
+    high = words[q]
+    q -= 1
+    word = words[q]
+    word >>= right
+    high <<= left
+    word |= high
+    word ^= _ZEROS32
+    word &= _KEEP32[length]
+    bad = word + _NOT_DIGIT32
+    bad |= word
+    high = word >> _U32(8)  # four digits, the first in the low byte, to their integer
+    word *= _U32(10)
+    word += high
+    word &= _PAIRS32
+    word *= _MUL32
+    word >>= _U32(16)
+    bad &= _U32(0x80808080)
+    return word, bad
+
+
 def _run(
     words: NDArray[np.uint64], last: IntArray, length: IntArray
 ) -> tuple[NDArray[np.uint64], NDArray[np.uint64]]:
@@ -485,8 +522,14 @@ def _digits(words: NDArray[np.uint64], first: IntArray, last: IntArray) -> IntAr
     """Tokens of one to eight digits → int64 (shaped like ``first``); None when one is
     anything else."""
     length = (last - first).reshape(-1)
-    if length.size and (length.min() < 1 or length.max() > 8):
+    longest = int(length.max(initial=0))
+    if length.size and (int(length.min()) < 1 or longest > 8):
         return None
+    if longest <= 4:
+        short, bad_short = _four(words.view(np.uint8), last.reshape(-1), length)
+        if bool(bad_short.any()):
+            return None
+        return short.astype(np.int64).reshape(first.shape)
     value, bad = _eight(_before(words, last.reshape(-1), 1)[0], length)
     if bool((bad & _HIGH).any()):
         return None
@@ -560,10 +603,16 @@ def exact_floats(
         frac_first = np.where(n_dot > 0, dot + 1, mantissa_end)
     n_int = int_end - body
     n_frac = mantissa_end - frac_first
-    whole, bad = _run(words, int_end, n_int)
-    fraction, bad_fraction = _run(words, mantissa_end, n_frac)
-    bad |= bad_fraction
+    fraction, bad = _run(words, mantissa_end, n_frac)
     bad &= _HIGH
+    if int(n_int.max(initial=0)) <= 4:  # most values: |x| < 10000
+        short, bad_short = _four(data, int_end, n_int)
+        whole = short.astype(np.uint64)
+        bad |= bad_short
+    else:
+        whole, bad_whole = _run(words, int_end, n_int)
+        bad_whole &= _HIGH
+        bad |= bad_whole
     total = n_int + n_frac
     if bool(bad.any()) or int(total.min(initial=1)) < 1:
         slow |= (bad != 0) | (total < 1)
