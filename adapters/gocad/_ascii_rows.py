@@ -125,7 +125,8 @@ class NodeRows:
         rows = ijk.shape[0]
         if rows == 0:
             return slice(0, 0)
-        if int(ijk.min()) < 0 or bool((ijk.max(axis=0) >= self.n).any()):
+        highest = [int(ijk[:, axis].max()) for axis in range(3)]  # (faster than axis=0)
+        if int(ijk.min()) < 0 or any(h >= n for h, n in zip(highest, self.counts, strict=True)):
             row = int(np.flatnonzero(((ijk < 0) | (ijk >= self.n)).any(axis=1))[0])
             raise FormatError(
                 f"ASCII data file: I J K {tuple(ijk[row].tolist())} is not a node of {self.counts}",
@@ -280,8 +281,10 @@ class _Table:
         if token_start.shape[0] != rows * columns:
             return None
         controls = np.count_nonzero(bytes_ < 32)
-        if controls != rows + 1 and bool(_CONTROL[bytes_].any()):
-            return None  # a control byte other than a line break, tab or carriage return
+        if controls != rows + 1:  # tabs or carriage returns, or other control bytes
+            allowed = rows + 1 + np.count_nonzero(bytes_ == 13) + np.count_nonzero(bytes_ == 9)
+            if controls != allowed:
+                return None  # a control byte other than a line break, tab or carriage return
         token_start = token_start.reshape(rows, columns)
         token_end = token_end.reshape(rows, columns)
         if not (
@@ -368,11 +371,6 @@ class _Table:
             line,
             np.array(lines, dtype=np.int64),
         )
-
-
-_CONTROL = np.zeros(256, dtype=bool)
-_CONTROL[:32] = True
-_CONTROL[[9, 10, 13]] = False  # tab, line feed, carriage return
 
 
 def _buffer(capacity: int) -> tuple[bytearray, NDArray[np.uint8], NDArray[np.uint64]]:
@@ -647,6 +645,9 @@ def exact_floats(
             extended /= _POW10_LD[exponent]
     significand = extended.view(np.uint64)[0::2]
     slow |= (significand & _U64(0x7FF)) == _U64(0x400)  # half way: the double rounding may err
-    values = extended.astype(np.float64)
-    np.negative(values, out=values, where=negative)
+    values = extended.astype(np.float64)  # >= 0: the sign bit is set for a minus sign
+    sign = negative.astype(np.uint64)
+    sign <<= _U64(63)
+    bits = values.view(np.uint64)
+    bits |= sign
     return values, slow

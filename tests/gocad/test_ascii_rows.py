@@ -272,3 +272,22 @@ def test_an_sgrid_ascii_table_takes_the_vectorised_path_and_refuses_doubles_and_
     table.write_text("\n".join(rows[:17] + rows[18:]) + "\n")
     with pytest.raises(FormatError, match=r"no row for node I J K \(2, 3, 0\) \(59 rows"):
         geobrep.read(tmp_path / "s.sg")
+
+
+def test_crlf_and_tab_separated_tables_take_the_vectorised_path(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _no_line_by_line(monkeypatch)
+    values = np.random.default_rng(4).normal(size=2000)
+    path = tmp_path / "t"
+    rows = [
+        f"{i % 10}\t{i // 10 % 10}\t{i // 100}\t{v!r}\r\n" for i, v in enumerate(values.tolist())
+    ]
+    path.write_bytes("".join(rows).encode())
+    ints, floats, lines = _rows(path)
+    assert np.array_equal(floats[:, 0], values)
+    assert ints[-1].tolist() == [9, 9, 19]
+    assert lines[-1] == 2000
+    path.write_bytes("".join(rows[:5]).encode() + b"5 0 0 \x0b1\r\n")  # a vertical tab
+    with pytest.raises(AssertionError, match="line by line"):
+        _rows(path)
