@@ -614,8 +614,8 @@ def exact_floats(
     total = n_int + n_frac
     if bool(bad.any()) or int(total.min(initial=1)) < 1:
         slow |= (bad != 0) | (total < 1)
-    if int(n_int.max(initial=0)) > 24 or int(n_frac.max(initial=0)) > 24:
-        slow |= (n_int > 24) | (n_frac > 24)
+    if int(n_int.max(initial=0)) > 19 or int(n_frac.max(initial=0)) > 19:
+        slow |= (n_int > 19) | (n_frac > 19)  # more than 19 digits may not fit in 64 bits
     longer = np.flatnonzero(total > 19)
     if longer.size:  # leading zeros, or more than 19 digits: m may not fit in 64 bits
         size = whole[longer].astype(np.float64) * 10.0 ** n_frac[longer].astype(np.float64)

@@ -46,6 +46,24 @@ def test_random_float64_round_trip_bit_for_bit(tmp_path: Path) -> None:
     assert lines[-1] == 3 + values.size
 
 
+def test_more_than_19_digits_are_exact(tmp_path: Path) -> None:
+    # 20 digits and more can exceed 2**64: those tokens are parsed one by one.
+    tokens = [
+        "123456789012345678901.5",
+        "99999999999999999999",
+        "-18446744073709551617.0",
+        "18446744073709551615",
+        "0.12345678901234567890123",
+        "1234567890.1234567890123",
+        "0.000000000000000000000012345",
+        "9999999999999999999",
+    ]
+    path = tmp_path / "t"
+    path.write_text("".join(f"{i} 0 0 {t}\n" for i, t in enumerate(tokens)))
+    _, floats, _ = _rows(path)
+    assert floats[:, 0].tolist() == [float(t) for t in tokens]
+
+
 def test_gocad_padded_columns_and_crlf(tmp_path: Path) -> None:
     path = tmp_path / "t"
     path.write_bytes(
