@@ -26,11 +26,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.adapters.gocad._keyed import KeyedFile, KeyedLine, parse_keyed, read_text
+from geobrep.adapters.gocad._ascii_rows import NodeRows, iter_rows
+from geobrep.adapters.gocad._keyed import MAX_TEXT, KeyedFile, KeyedLine, parse_keyed, read_text
 from geobrep.adapters.gocad._objects import report
 from geobrep.adapters.gocad._voxet import (
     PropertyFile,
-    ascii_numbers,
     mapped_array,
     property_dtype,
     property_lines,
@@ -191,30 +191,27 @@ def _prop_alignment(prop: PropertyFile, layout: SGridLayout) -> str:
 
 
 def _ascii_rows(layout: SGridLayout, path: Path, n_props: int) -> NDArray[np.float64]:
-    """The ``X Y Z value... I J K`` rows of the ASCII data file, in node order."""
+    """The ``X Y Z value... I J K`` rows of the ASCII data file, in node order (each node
+    once), parsed vectorised and exactly like a Voxet's table (:mod:`._ascii_rows`)."""
     assert layout.ascii_file is not None
     side = side_file(path, layout.ascii_file, "ASCII_DATA_FILE")
     if not side.is_file():
         raise FormatError(f"the ASCII_DATA_FILE {str(side)!r} is missing", path)
     columns = 6 + n_props
     check_declared(8 * columns * layout.n_nodes, side.stat().st_size, "AXIS_N", side)
-    numbers = ascii_numbers(side)
-    if numbers.size != columns * layout.n_nodes:
+    ijk = (3 + n_props, 4 + n_props, 5 + n_props)
+    ordered = np.empty((layout.n_nodes, 3 + n_props), dtype=np.float64)
+    nodes = NodeRows(layout.nodes, side)  # a node listed twice is a FormatError naming the line
+    for chunk in iter_rows(side, columns, ijk, MAX_TEXT):
+        ordered[nodes.place(chunk)] = chunk.floats
+    missing = nodes.first_missing()
+    if missing is not None:
         raise FormatError(
-            f"ASCII data file: {numbers.size} numbers, {layout.n_nodes} nodes of {columns} "
-            f"columns (X Y Z, {n_props} properties, I J K) need {columns * layout.n_nodes}",
+            f"ASCII data file: no row for node I J K {missing} ({nodes.listed} rows of "
+            f"{columns} columns, X Y Z, {n_props} properties, I J K, for {layout.n_nodes} "
+            "nodes)",
             side,
         )
-    rows = numbers.reshape(-1, columns)
-    ijk = rows[:, -3:]
-    n = np.array(layout.nodes)
-    if not (np.all(ijk == np.round(ijk)) and np.all((ijk >= 0) & (ijk < n))):
-        raise FormatError(f"ASCII data file: an I J K index is not a node of {layout.nodes}", side)
-    index = (ijk[:, 0] + n[0] * (ijk[:, 1] + n[1] * ijk[:, 2])).astype(np.int64)
-    if np.unique(index).size != index.size:
-        raise FormatError("ASCII data file: a node is listed twice", side)
-    ordered = np.empty_like(rows)
-    ordered[index] = rows
     return ordered
 
 

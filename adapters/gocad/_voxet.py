@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.adapters.gocad._ascii_rows import iter_rows
+from geobrep.adapters.gocad._ascii_rows import NodeRows, iter_rows
 from geobrep.adapters.gocad._keyed import MAX_TEXT, KeyedFile, KeyedLine, parse_keyed, read_text
 from geobrep.adapters.limits import check_declared, human_bytes, parse_numbers
 from geobrep.errors import EntityValidationError, FormatError
@@ -219,21 +219,12 @@ def _ascii_table(
         raise FormatError(f"the ASCII_DATA_FILE {str(side)!r} is missing", path)
     total = int(np.prod(counts))
     check_declared(8 * total * max(len(props), 1), side.stat().st_size, "AXIS_N", side)
-    n = np.array(counts, dtype=np.int64)
     out = [np.full(total, np.nan if p.no_data is None else p.no_data) for p in props]
+    nodes = NodeRows(counts, side)  # a node listed twice is a FormatError naming the line
     for chunk in iter_rows(side, 3 + len(props), (0, 1, 2), MAX_TEXT):
-        ijk = chunk.ints
-        outside = np.flatnonzero(((ijk < 0) | (ijk >= n)).any(axis=1))
-        if outside.size:
-            row = int(outside[0])
-            raise FormatError(
-                f"ASCII data file: I J K {tuple(ijk[row].tolist())} is not a node of {counts}",
-                side,
-                chunk.line(row),
-            )
-        index = ijk[:, 0] + n[0] * (ijk[:, 1] + n[1] * ijk[:, 2])
+        where = nodes.place(chunk)
         for column, values in enumerate(out):
-            values[index] = chunk.floats[:, column]
+            values[where] = chunk.floats[:, column]
     return out
 
 
