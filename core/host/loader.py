@@ -111,7 +111,9 @@ class PluginInfo(BaseModel):
 
     ``registered`` maps each kind (``"formats"``, ``"clippers"``, ``"fitters"``,
     ``"builders"``) to the names this plugin holds in the registries; empty tuples for a
-    plugin that failed or is disabled.
+    plugin that failed or is disabled. A built-in plugin is ``"loaded"`` with its declared
+    items from discovery on (:mod:`geobrep.host._declared`), though its module is imported only
+    when one of them is first used; should that import fail, it becomes ``"failed"``.
 
     Example:
         >>> info = PluginInfo(name="example", module="geobrep_example_plugin", status="disabled")

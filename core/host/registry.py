@@ -621,16 +621,17 @@ class Registry(Generic[T]):
 
     def pending(self, plugin: str) -> list[str]:
         """The names ``plugin`` declared that are not imported yet."""
-        return sorted(name for name, item in self._pending.items() if item.plugin == plugin)
+        pending = list(self._pending.items())  # a copy: another thread may import meanwhile
+        return sorted(name for name, item in pending if item.plugin == plugin)
 
     def forget_pending(self, plugin: str) -> None:
         """Drop the items ``plugin`` declared and did not register (its import failed)."""
         for name in self.pending(plugin):
-            del self._pending[name]
+            self._pending.pop(name, None)
 
     def load_pending(self) -> None:
         """Import every plugin with an item pending here (each once)."""
-        loads = {id(item.load): item.load for item in self._pending.values()}
+        loads = {id(item.load): item.load for item in list(self._pending.values())}
         for load in loads.values():
             load()
 
