@@ -1,18 +1,15 @@
 """The GOCAD objects read line by line: Voxet (.vo), SGrid (.sg) and Well (.wl), to and from
-scenes."""
+scenes.
+
+Only :func:`object_type_of` is needed to read any GOCAD file: each object's reader and writer
+is imported when a file of its type is read or written (a .ts read loads none of them).
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from geobrep.adapters.gocad._lexer import split_tokens
-from geobrep.adapters.gocad._objects import report
-from geobrep.adapters.gocad._reader import crs_from_block
-from geobrep.adapters.gocad._sgrid import read_sgrid
-from geobrep.adapters.gocad._sgrid_writer import write_sgrid
-from geobrep.adapters.gocad._voxet import read_voxet
-from geobrep.adapters.gocad._voxet_writer import write_voxet
-from geobrep.adapters.gocad._well import read_well, well_text
 from geobrep.errors import FormatError
 from geobrep.model.entities import Entity, RegularGrid, StructuredGrid, Well
 from geobrep.model.scene import Scene
@@ -44,13 +41,25 @@ def object_type_of(path: Path) -> str | None:
 
 def read_grid_object(path: Path, object_type: str) -> Scene:
     """A scene holding the object of a Voxet, SGrid or Well file."""
-    if object_type in ("Voxet", "SGrid"):
-        grid, keyed = read_voxet(path) if object_type == "Voxet" else read_sgrid(path)
-        crs = crs_from_block(keyed.crs) if keyed.crs is not None else None
-        return Scene(entities=[grid.replace(id=0)], crs=crs, name=path.stem)
-    well, block = read_well(path)
-    crs = crs_from_block(block) if block is not None else None
-    return Scene(entities=[well.replace(id=0)], crs=crs, name=path.stem)
+    from geobrep.adapters.gocad._reader import crs_from_block
+
+    grid: RegularGrid | StructuredGrid
+    if object_type == "Voxet":
+        from geobrep.adapters.gocad._voxet import read_voxet
+
+        grid, keyed = read_voxet(path)
+    elif object_type == "SGrid":
+        from geobrep.adapters.gocad._sgrid import read_sgrid
+
+        grid, keyed = read_sgrid(path)
+    else:
+        from geobrep.adapters.gocad._well import read_well
+
+        well, block = read_well(path)
+        crs = crs_from_block(block) if block is not None else None
+        return Scene(entities=[well.replace(id=0)], crs=crs, name=path.stem)
+    crs = crs_from_block(keyed.crs) if keyed.crs is not None else None
+    return Scene(entities=[grid.replace(id=0)], crs=crs, name=path.stem)
 
 
 def grid_object_for(path: Path, object_type: str | None) -> str | None:
@@ -62,6 +71,8 @@ def grid_object_for(path: Path, object_type: str | None) -> str | None:
 
 def write_grid_object(scene: Scene, path: Path, object_type: str, ascii_data: bool = False) -> None:
     """Write the scene's one entity of the object type's entity class."""
+    from geobrep.adapters.gocad._objects import report
+
     _, wanted = GRID_OBJECTS[object_type]
     chosen = [e for e in scene.entities if isinstance(e, wanted)]
     if not chosen:
@@ -72,9 +83,15 @@ def write_grid_object(scene: Scene, path: Path, object_type: str, ascii_data: bo
         report(f"a {object_type} file holds one {wanted.__name__}; not written: {shown}")
     entity = chosen[0]
     if isinstance(entity, RegularGrid):
+        from geobrep.adapters.gocad._voxet_writer import write_voxet
+
         write_voxet(entity, scene.crs, path, ascii_data)
     elif isinstance(entity, StructuredGrid):
+        from geobrep.adapters.gocad._sgrid_writer import write_sgrid
+
         write_sgrid(entity, scene.crs, path)
     else:
+        from geobrep.adapters.gocad._well import well_text
+
         assert isinstance(entity, Well)
         path.write_text(well_text(entity, scene.crs), encoding="utf-8")

@@ -23,7 +23,6 @@ from numpy.typing import NDArray
 
 from geobrep.adapters.gocad._headers import PropertyHeader, color_from_text
 from geobrep.adapters.gocad._lexer import Source
-from geobrep.adapters.gocad._model3d import attach_model3d
 from geobrep.adapters.gocad._objects import gocad_section
 from geobrep.adapters.gocad._parser import GROUP_TYPES, GocadObject, GocadWarning, parse_source
 from geobrep.adapters.gocad._records import CrsBlock, ErrorFactory, SolidSurface
@@ -163,6 +162,8 @@ class _Builder:
         name = objects[0].name
         metadata: dict[str, Any] = {}
         if models:
+            from geobrep.adapters.gocad._model3d import attach_model3d  # Model3d files only
+
             if len(models) > 1:
                 self.warn(
                     f"{len(models)} Model3d objects: only the first with TFACEs defines "

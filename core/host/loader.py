@@ -12,6 +12,12 @@ The import and the hooks of a plugin from another distribution run in a daemon t
 ``GEOBREP_PLUGIN_TIMEOUT`` seconds (default 10) is reported, skipped and abandoned. geobrep's
 own plugins are imported directly and their items are marked ``builtin``.
 
+geobrep's own plugins are not imported at discovery: their items are declared as plain data
+(:mod:`geobrep.host._declared`), held in the registries as
+:class:`~geobrep.host.registry.Pending` entries, and a plugin's module is imported (and its
+hooks called) when one of its items is first used (:meth:`PluginHost.materialize`). Such a
+plugin is listed ``"loaded"`` with its declared items from the start.
+
 Environment:
     ``GEOBREP_STRICT_PLUGINS=1`` (also ``true``/``yes``/``on``): a failure raises
     :class:`~geobrep.errors.PluginError` instead of warning.
@@ -31,15 +37,15 @@ import threading
 import types
 import warnings
 from collections.abc import Iterable
+from functools import cached_property, partial
 from importlib.metadata import EntryPoint, entry_points
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
-import pluggy
 from pydantic import BaseModel, ConfigDict, Field
 
 from geobrep.errors import PluginError
-from geobrep.hookspecs import PROJECT_NAME, GeobrepSpecs
-from geobrep.host._entry_points import ENTRY_POINT_GROUP
+from geobrep.host._declared import BUILTIN_PLUGINS
+from geobrep.host._entry_points import ENTRY_POINT_GROUP, PROJECT_NAME
 from geobrep.host._entry_points import distribution as _distribution
 from geobrep.host._entry_points import is_builtin as _is_builtin
 from geobrep.host._entry_points import is_own as _is_own
@@ -52,7 +58,16 @@ from geobrep.host._isolation import (
     plugin_timeout,
     strict_mode,
 )
-from geobrep.host.registry import GeobrepPluginWarning, RegisteredItem, Registries, Registry
+from geobrep.host.registry import (
+    GeobrepPluginWarning,
+    Pending,
+    RegisteredItem,
+    Registries,
+    Registry,
+)
+
+if TYPE_CHECKING:
+    import pluggy
 
 __all__ = [
     "DISABLE_ENV",
@@ -96,7 +111,9 @@ class PluginInfo(BaseModel):
 
     ``registered`` maps each kind (``"formats"``, ``"clippers"``, ``"fitters"``,
     ``"builders"``) to the names this plugin holds in the registries; empty tuples for a
-    plugin that failed or is disabled.
+    plugin that failed or is disabled. A built-in plugin is ``"loaded"`` with its declared
+    items from discovery on (:mod:`geobrep.host._declared`), though its module is imported only
+    when one of them is first used; should that import fail, it becomes ``"failed"``.
 
     Example:
         >>> info = PluginInfo(name="example", module="geobrep_example_plugin", status="disabled")
@@ -132,6 +149,11 @@ def discover_entry_points() -> list[EntryPoint]:
     return sorted(entry_points(group=ENTRY_POINT_GROUP), key=order)
 
 
+def _listed(registered: dict[str, tuple[str, ...]]) -> str:
+    parts = [f"{kind} {', '.join(names)}" for kind, names in registered.items() if names]
+    return "; ".join(parts) or "nothing"
+
+
 def _origin(name: str, module: str, distribution: str | None, version: str | None) -> str:
     if distribution is None:
         return f"plugin {name!r} (module {module!r}, no distribution)"
@@ -154,11 +176,21 @@ class PluginHost:
     """
 
     def __init__(self) -> None:
-        self.manager = pluggy.PluginManager(PROJECT_NAME)
-        self.manager.add_hookspecs(GeobrepSpecs)
         self.registries = Registries()
         self._plugins: list[PluginInfo] = []
+        self._deferred: dict[str, EntryPoint] = {}
         self._lock = threading.RLock()
+
+    @cached_property
+    def manager(self) -> pluggy.PluginManager:
+        """The pluggy manager (made when the first plugin is imported)."""
+        import pluggy
+
+        from geobrep.hookspecs import GeobrepSpecs
+
+        manager = pluggy.PluginManager(PROJECT_NAME)
+        manager.add_hookspecs(GeobrepSpecs)
+        return manager
 
     @property
     def plugins(self) -> list[PluginInfo]:
@@ -222,6 +254,10 @@ class PluginHost:
             return
         if self._taken(name, module, distribution, version):
             return
+        declared = BUILTIN_PLUGINS.get(name)
+        if builtin and declared is not None and declared[0] == module:
+            self._declare(entry_point, declared[1], distribution, version)
+            return
         limit = None if builtin else plugin_timeout()
         try:
             if limit is None:
@@ -234,6 +270,83 @@ class PluginHost:
             self._fail(name, module, distribution, version, exc)
             return
         self._register(plugin, name, module, distribution, version, builtin=builtin, limit=limit)
+
+    def _declare(
+        self,
+        entry_point: EntryPoint,
+        items: Iterable[Any],
+        distribution: str | None,
+        version: str | None,
+    ) -> None:
+        """List a built-in plugin with its declared items, pending in the registries; its
+        module is imported when one of them is used (:meth:`materialize`)."""
+        name = entry_point.name
+        load = partial(self.materialize, name)
+        targets = self.registries.by_kind()
+        registered: dict[str, list[str]] = {kind: [] for kind in Registries.KINDS}
+        for item in items:
+            if targets[item.kind].declare(Pending(item, name, load)):
+                registered[item.kind].append(item.name)
+        self._deferred[name] = entry_point
+        self._plugins.append(
+            PluginInfo(
+                name=name,
+                module=entry_point.module,
+                distribution=distribution,
+                version=version,
+                status="loaded",
+                builtin=True,
+                registered={kind: tuple(sorted(names)) for kind, names in registered.items()},
+            )
+        )
+
+    def materialize(self, name: str) -> None:
+        """Import the built-in plugin ``name`` if it is still pending, call its hooks and put
+        its items in the place of their declarations (nothing if it was imported already).
+
+        A failure is reported like a failing plugin's (a warning, or
+        :class:`~geobrep.errors.PluginError` in strict mode); its declared items are dropped.
+        An item its hooks register that was not declared, or one declared and not registered,
+        is a :class:`~geobrep.errors.PluginError` (the declarations are out of date).
+        """
+        with self._lock:
+            entry_point = self._deferred.pop(name, None)
+            if entry_point is None:
+                return
+            index = next(i for i, info in enumerate(self._plugins) if info.name == name)
+            declared = self._plugins[index]
+            try:
+                plugin = entry_point.load()
+                staging = Registries.staging(name, builtin=True)
+                if self.manager.register(plugin, name=name) is None:
+                    raise PluginError(f"pluggy blocked the plugin name {name!r}")
+                self.manager.check_pending()
+                self._call_hooks(name, staging)
+            except KeyboardInterrupt:
+                raise
+            except BaseException as exc:  # isolated and reported like any plugin's failure
+                for registry in self.registries.by_kind().values():
+                    registry.forget_pending(name)
+                del self._plugins[index]
+                failed = self._fail(
+                    name, declared.module, declared.distribution, declared.version, exc
+                )
+                self._plugins.remove(failed)
+                self._plugins.insert(index, failed)
+                return
+            registered = self._commit(staging)
+            left = {
+                kind: registry.pending(name)
+                for kind, registry in self.registries.by_kind().items()
+                if registry.pending(name)
+            }
+            if registered != declared.registered or left:
+                for registry in self.registries.by_kind().values():
+                    registry.forget_pending(name)
+                raise PluginError(
+                    f"the built-in plugin {name!r} registered {_listed(registered)}, but "
+                    f"geobrep.host._declared declares {_listed(declared.registered)}"
+                )
 
     def _taken(self, name: str, module: str, distribution: str | None, version: str | None) -> bool:
         for info in self._plugins:

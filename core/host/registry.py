@@ -17,7 +17,7 @@ from __future__ import annotations
 import os
 import re
 import warnings
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Generic, Protocol, TypeVar, runtime_checkable
@@ -32,6 +32,7 @@ from pydantic import (
 )
 
 from geobrep.errors import GeobrepError, OptionsError, PluginError, UnknownFormatError
+from geobrep.host._declared import Declared
 from geobrep.host._isolation import (
     SNIFF_TIMEOUT_ENV,
     PluginTimeoutError,
@@ -67,6 +68,7 @@ __all__ = [
     "GeobrepPluginWarning",
     "LossReporter",
     "NoOptions",
+    "Pending",
     "Reader",
     "RegisteredItem",
     "Registries",
@@ -184,7 +186,7 @@ class UnknownItemError(GeobrepError, KeyError):
 class NoOptions(BaseModel):
     """The options model of an item that takes no options: any option is rejected."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, defer_build=True)
 
 
 def _format_loc(loc: tuple[int | str, ...]) -> str:
@@ -203,7 +205,7 @@ class RegisteredItem(BaseModel):
         PlaneOptions(tolerance=0.5)
     """
 
-    model_config = ConfigDict(frozen=True, arbitrary_types_allowed=True)
+    model_config = ConfigDict(frozen=True, arbitrary_types_allowed=True, defer_build=True)
 
     kind: ClassVar[str] = "item"
 
@@ -324,7 +326,7 @@ class FormatCapabilities(BaseModel):
         True
     """
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", defer_build=True)
 
     entity_types: frozenset[str] = frozenset()
     point_data: bool = False
@@ -497,6 +499,46 @@ class CheckSpec(RegisteredItem):
 T = TypeVar("T", bound=RegisteredItem)
 
 
+@dataclass(frozen=True, eq=False)
+class Pending:
+    """A declared item of a built-in plugin whose module is not imported yet.
+
+    The registry holds it under its name until the item is used: ``load()`` imports the
+    plugin and replaces each of its pending items by the item its hook registers. It answers
+    what choosing a format needs without the import (:mod:`geobrep.host._declared`).
+    """
+
+    declared: Declared
+    plugin: str
+    load: Callable[[], None]
+    builtin: bool = True
+
+    @property
+    def name(self) -> str:
+        """The item's name."""
+        return self.declared.name
+
+    @property
+    def extensions(self) -> tuple[str, ...]:
+        """A format's extensions."""
+        return self.declared.extensions
+
+    @property
+    def can_read(self) -> bool:
+        """A format that reads."""
+        return self.declared.reads
+
+    @property
+    def can_write(self) -> bool:
+        """A format that writes."""
+        return self.declared.writes
+
+    @property
+    def generic_content(self) -> bool:
+        """A format whose sniffer recognises generic content."""
+        return self.declared.generic_content
+
+
 class Registry(Generic[T]):
     """Items of one kind by name, iterated in name order.
 
@@ -517,6 +559,7 @@ class Registry(Generic[T]):
         self, items: Iterable[T] = (), *, plugin: str | None = None, builtin: bool = False
     ) -> None:
         self._items: dict[str, T] = {}
+        self._pending: dict[str, Pending] = {}
         self.plugin = plugin
         self.builtin = builtin
         for item in items:
@@ -540,6 +583,13 @@ class Registry(Generic[T]):
             )
         if self.plugin is not None and (item.plugin, item.builtin) != (self.plugin, self.builtin):
             item = item.model_copy(update={"plugin": self.plugin, "builtin": self.builtin})
+        pending = self._pending.get(item.name)
+        if pending is not None and pending.plugin == item.plugin:
+            del self._pending[item.name]  # the declared item, now imported
+            self._items[item.name] = item
+            return item
+        if pending is not None:
+            pending.load()  # the item the name is taken by, to return it
         existing = self._items.get(item.name)
         if existing is None:
             self._items[item.name] = item
@@ -549,38 +599,91 @@ class Registry(Generic[T]):
                 f"{item.label} registered twice by {_plugin_label(item.plugin)}: "
                 "each name may be registered once"
             )
-        warnings.warn(
-            f"{item.label} from {_plugin_label(item.plugin)} ignored: the name is already "
-            f"registered by {_plugin_label(existing.plugin)}",
-            GeobrepPluginWarning,
-            stacklevel=2,
-        )
+        self._warn_taken(item.label, item.plugin, existing.plugin)
         return existing
+
+    def declare(self, pending: Pending) -> bool:
+        """Hold ``pending`` under its name until it is used; False if the name is taken (a
+        warning, like :meth:`add`: the first registration wins)."""
+        name = pending.name
+        existing = self._items.get(name) or self._pending.get(name)
+        if existing is None:
+            self._pending[name] = pending
+            return True
+        label = f"{self.kind} {name!r}"
+        if existing.plugin == pending.plugin:
+            raise PluginError(
+                f"{label} registered twice by {_plugin_label(pending.plugin)}: "
+                "each name may be registered once"
+            )
+        self._warn_taken(label, pending.plugin, existing.plugin)
+        return False
+
+    def pending(self, plugin: str) -> list[str]:
+        """The names ``plugin`` declared that are not imported yet."""
+        pending = list(self._pending.items())  # a copy: another thread may import meanwhile
+        return sorted(name for name, item in pending if item.plugin == plugin)
+
+    def forget_pending(self, plugin: str) -> None:
+        """Drop the items ``plugin`` declared and did not register (its import failed)."""
+        for name in self.pending(plugin):
+            self._pending.pop(name, None)
+
+    def load_pending(self) -> None:
+        """Import every plugin with an item pending here (each once)."""
+        loads = {id(item.load): item.load for item in list(self._pending.values())}
+        for load in loads.values():
+            load()
+
+    def entries(self) -> list[T | Pending]:
+        """Every item by name, pending ones as they are (no plugin is imported)."""
+        every: dict[str, T | Pending] = {**self._pending, **self._items}
+        return [every[name] for name in sorted(every)]
+
+    def loaded(self, entry: T | Pending) -> T | None:
+        """The registered item ``entry`` stands for, importing its plugin if it is pending
+        (None if that import failed)."""
+        if isinstance(entry, Pending):
+            entry.load()
+            return self._items.get(entry.name)
+        return entry
+
+    def _warn_taken(self, label: str, plugin: str, holder: str) -> None:
+        warnings.warn(
+            f"{label} from {_plugin_label(plugin)} ignored: the name is already "
+            f"registered by {_plugin_label(holder)}",
+            GeobrepPluginWarning,
+            stacklevel=3,
+        )
 
     def get(self, name: str) -> T:
         """The item called ``name``; :class:`UnknownItemError` lists the names if absent."""
+        pending = self._pending.get(name)
+        if pending is not None:
+            pending.load()
         try:
             return self._items[name]
         except KeyError:
             raise UnknownItemError(f"unknown {self.kind} {name!r}; {self._available()}") from None
 
     def names(self) -> list[str]:
-        """Registered names, sorted."""
-        return sorted(self._items)
+        """Registered names, sorted (pending ones too: no plugin is imported)."""
+        return sorted([*self._items, *self._pending])
 
     def _available(self) -> str:
-        if not self._items:
+        if not self._items and not self._pending:
             return f"no {self.kind}s are registered"
         return f"registered {self.kind}s: " + ", ".join(self.names())
 
     def __contains__(self, name: object) -> bool:
-        return name in self._items
+        return name in self._items or name in self._pending
 
     def __iter__(self) -> Iterator[T]:
-        return iter([self._items[name] for name in self.names()])
+        self.load_pending()
+        return iter([self._items[name] for name in sorted(self._items)])
 
     def __len__(self) -> int:
-        return len(self._items)
+        return len(self._items) + len(self._pending)
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.names()!r})"
@@ -599,7 +702,14 @@ def _read_head(path: Path) -> bytes:
         return b""
 
 
-def _describe_formats(formats: Iterable[FormatSpec]) -> str:
+def _sniffs_at_all(entry: FormatSpec | Pending) -> bool:
+    """Whether the format has a sniffer (a pending one: whether it declares one)."""
+    if isinstance(entry, Pending):
+        return entry.declared.sniffs
+    return entry.sniff is not None
+
+
+def _describe_formats(formats: Iterable[FormatSpec | Pending]) -> str:
     parts = []
     for spec in formats:
         extensions = ", ".join(spec.extensions) or "no extension"
@@ -653,11 +763,12 @@ class FormatRegistry(Registry[FormatSpec]):
         path = Path(path)
         if format is not None:
             return self._named(format, path, "read")
-        readers = self.readers()
+        readers = self._able("read")
         candidates = break_tie(_longest_match(readers, path))
         head = _read_head(path) if candidates else b""
         if len(candidates) == 1:
-            return self._extension_or_content(candidates[0], readers, head)
+            chosen = self._extension_or_content(candidates[0], readers, head)
+            return self._chosen(chosen, lambda: self.choose_reader(path))
         head = head or _read_head(path)
         pool = candidates or readers
         sniffed = [spec for spec in pool if self._sniffs(spec, head)]
@@ -666,7 +777,7 @@ class FormatRegistry(Registry[FormatSpec]):
             sniffed = specific  # a format that knows this content beats a generic one
         sniffed = break_tie(sniffed)
         if len(sniffed) == 1:
-            return sniffed[0]
+            return self._chosen(sniffed[0], lambda: self.choose_reader(path))
         if sniffed or candidates:
             self._ambiguous(sniffed or candidates, path, "read")
         raise UnknownFormatError(
@@ -688,10 +799,10 @@ class FormatRegistry(Registry[FormatSpec]):
         path = Path(path)
         if format is not None:
             return self._named(format, path, "write")
-        writers = self.writers()
+        writers = self._able("write")
         candidates = break_tie(_longest_match(writers, path))
         if len(candidates) == 1:
-            return candidates[0]
+            return self._chosen(candidates[0], lambda: self.choose_writer(path))
         if candidates:
             self._ambiguous(candidates, path, "write")
         raise UnknownFormatError(
@@ -701,8 +812,20 @@ class FormatRegistry(Registry[FormatSpec]):
             path=path,
         )
 
+    def _able(self, action: str) -> list[FormatSpec | Pending]:
+        """The formats (pending ones as declared) that can ``action`` ("read", "write")."""
+        if action == "read":
+            return [entry for entry in self.entries() if entry.can_read]
+        return [entry for entry in self.entries() if entry.can_write]
+
+    def _chosen(self, entry: FormatSpec | Pending, again: Callable[[], FormatSpec]) -> FormatSpec:
+        """The format ``entry`` stands for; if its plugin failed to import, choose ``again``
+        (among the formats left)."""
+        spec = self.loaded(entry)
+        return again() if spec is None else spec
+
     def _named(self, name: str, path: Path, action: str) -> FormatSpec:
-        able = self.readers() if action == "read" else self.writers()
+        able = self._able(action)
         if name not in self:
             raise UnknownFormatError(
                 f"unknown format {name!r}; formats that can {action}: {_describe_formats(able)}",
@@ -718,7 +841,7 @@ class FormatRegistry(Registry[FormatSpec]):
         return spec
 
     @staticmethod
-    def _ambiguous(candidates: list[FormatSpec], path: Path, action: str) -> None:
+    def _ambiguous(candidates: list[FormatSpec | Pending], path: Path, action: str) -> None:
         raise UnknownFormatError(
             f"several formats can {action} this file: {_describe_formats(candidates)}; "
             f"pass format='<name>' to choose one",
@@ -726,15 +849,15 @@ class FormatRegistry(Registry[FormatSpec]):
         )
 
     def _extension_or_content(
-        self, chosen: FormatSpec, readers: list[FormatSpec], head: bytes
-    ) -> FormatSpec:
+        self, chosen: FormatSpec | Pending, readers: list[FormatSpec | Pending], head: bytes
+    ) -> FormatSpec | Pending:
         """The format an extension names, unless its sniffer refuses the content and exactly one
         other format knows it (a GeoJSON file named ``.json``, the extension of 3D Tiles).
 
         Without a sniffer, or with no head, or when no other specific format claims the content,
         the extension's format reads it (and its reader says what is wrong).
         """
-        if chosen.sniff is None or not head or self._sniffs(chosen, head):
+        if not _sniffs_at_all(chosen) or not head or self._sniffs(chosen, head):
             return chosen
         others = [
             spec
@@ -743,8 +866,12 @@ class FormatRegistry(Registry[FormatSpec]):
         ]
         return others[0] if len(others) == 1 else chosen
 
-    @staticmethod
-    def _sniffs(spec: FormatSpec, head: bytes) -> bool:
+    def _sniffs(self, entry: FormatSpec | Pending, head: bytes) -> bool:
+        if not head or not _sniffs_at_all(entry):
+            return False
+        spec = self.loaded(entry)  # a pending format's sniffer: its plugin is imported
+        if spec is None:
+            return False
         sniff = spec.sniff
         if sniff is None or not head or id(sniff) in _HUNG_SNIFFERS:
             return False
@@ -787,7 +914,11 @@ def preferred_formats() -> tuple[str, ...]:
     return tuple(part.strip().lower() for part in raw.split(",") if part.strip())
 
 
-def _preferred(formats: list[FormatSpec]) -> FormatSpec | None:
+#: A format, or a built-in one not imported yet.
+F = TypeVar("F", bound=FormatSpec | Pending)
+
+
+def _preferred(formats: list[F]) -> F | None:
     by_name = {spec.name: spec for spec in formats}
     for name in preferred_formats():
         if name in by_name:
@@ -795,7 +926,7 @@ def _preferred(formats: list[FormatSpec]) -> FormatSpec | None:
     return None
 
 
-def break_tie(formats: list[FormatSpec]) -> list[FormatSpec]:
+def break_tie(formats: list[F]) -> list[F]:
     """Of formats matching a file equally: the first preferred one, else the built-in ones.
 
     A plugin's format overrides a built-in one only when asked: by ``format=`` or by naming
@@ -822,7 +953,7 @@ def _longest_extension(extensions: Iterable[str], file_name: str) -> str | None:
     return max(hits, key=len) if hits else None
 
 
-def _longest_match(formats: list[FormatSpec], path: Path) -> list[FormatSpec]:
+def _longest_match(formats: list[F], path: Path) -> list[F]:
     name = path.name.lower()  # once, not once per format (a Path each cost 1 ms a file)
     matched = [(spec, _longest_extension(spec.extensions, name)) for spec in formats]
     longest = max((len(ext) for _, ext in matched if ext), default=0)

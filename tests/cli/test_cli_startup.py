@@ -22,6 +22,7 @@ from geobrep import Scene, read
 from geobrep.batch.operations import builtin_operations
 from geobrep.cli.commands import COMMANDS, Command
 from geobrep.cli.main import build_parser, main
+from geobrep.host._declared import BUILTIN_PLUGINS
 from geobrep.host.loader import set_host
 from geobrep.plugins import OperationRegistry, OperationSpec, hookimpl, register
 
@@ -63,15 +64,18 @@ NOT_FOR_HELP = (
     "geobrep.adapters",
 )
 
-#: What describing a TSurf must not load: kernels, reprojection, other commands, step models.
+#: What describing a TSurf must not load: kernels, reprojection, other commands, step models,
+#: any plugin but GOCAD's (geobrep's own are declared and imported on first use), meshio.
 NOT_FOR_INFO = (
     "scipy",
     "pyproj",
+    "meshio",
     "geobrep.gis.crs_ops",
-    "geobrep.plugins.blocks._",
-    "geobrep.plugins.clip._",
-    "geobrep.plugins.voxelize._",
-    "geobrep.plugins.fit._",
+    *(module for name, (module, _) in BUILTIN_PLUGINS.items() if name != "gocad"),
+    "geobrep.adapters.gocad._model3d",
+    "geobrep.adapters.gocad._voxet",
+    "geobrep.adapters.gocad._sgrid",
+    "geobrep.adapters.gocad._well",
     "geobrep.batch.pipeline",
     "geobrep.batch.operations",
     "geobrep.cli.operation",

@@ -9,12 +9,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from pydantic import Field, model_validator
 
-from geobrep.geometry import nurbs as nurbs_eval
 from geobrep.geometry.bbox import BoundingBox
 from geobrep.model.arrays import ControlNet, FloatArray, WeightGrid
 from geobrep.model.entities.base import Entity
 
 if TYPE_CHECKING:
+    from geobrep.geometry import nurbs as nurbs_eval
     from geobrep.model.entities.surface import Surface
 
 __all__ = ["NurbsSurface"]
@@ -83,6 +83,8 @@ class NurbsSurface(Entity):
         >>> s.net.shape, s.net.weights is None
         ((2, 2), True)
         """
+        from geobrep.geometry import nurbs as nurbs_eval  # the evaluator, on first use
+
         return nurbs_eval.NurbsNet(
             self.degree_u,
             self.degree_v,
@@ -101,10 +103,14 @@ class NurbsSurface(Entity):
         >>> s.evaluate([0.5], [0.25]).tolist()
         [[0.5, 0.25, 0.0]]
         """
+        from geobrep.geometry import nurbs as nurbs_eval
+
         return nurbs_eval.surface_points(self.net, u, v)
 
     def derivatives(self, u: ArrayLike, v: ArrayLike, order: int = 1) -> NDArray[np.float64]:
         """Partial derivatives ``[:, k, l] = ∂^(k+l)S/∂u^k∂v^l`` (``k + l <= order``)."""
+        from geobrep.geometry import nurbs as nurbs_eval
+
         return nurbs_eval.surface_derivatives(self.net, u, v, order=order)
 
     def tessellate(
@@ -124,6 +130,7 @@ class NurbsSurface(Entity):
         >>> mesh.n_vertices, mesh.n_faces, mesh.area
         (9, 8, 1.0)
         """
+        from geobrep.geometry import nurbs as nurbs_eval
         from geobrep.model.entities.surface import Surface
 
         if resolution is not None and tolerance is not None:
