@@ -323,7 +323,9 @@ def fit_hybrid(entities: list[Entity], options: HybridOptions) -> FitResult:
         pointset, points.shape[0], options.weight_property, options.exact_property, LABEL
     )
     hard = np.zeros(points.shape[0], bool) if hard is None else hard
-    core_mask = _checked_core_mask(points, frame, options, pointset, hard)
+    # the core interpolates: a weighted point there would be met exactly, against its weight
+    not_core = hard if weights is None else hard | (weights != 1.0)
+    core_mask = _checked_core_mask(points, frame, options, pointset, not_core)
     core = _corrected_core(
         _skinned_core(points, core_mask, frame, options, (weights, hard)), options
     )
@@ -352,17 +354,25 @@ def _checked_core_mask(
     frame: LocalFrame,
     options: HybridOptions,
     pointset: PointSet | None,
-    hard: NDArray[np.bool_],
+    not_core: NDArray[np.bool_],
 ) -> NDArray[np.bool_]:
-    """The core points (never hard data); a core too small to skin or an empty rim is an
-    options error."""
+    """The core points (never hard data nor points of weight other than 1, which the core
+    would meet exactly); a core too small to skin or an empty rim is an options error."""
     p, q = options.degree_u, options.degree_v
-    core_mask = _core_mask(points, frame.to_local(points)[:, :2], options, pointset) & ~hard
+    found = _core_mask(points, frame.to_local(points)[:, :2], options, pointset)
+    core_mask = found & ~not_core
     n_core, n_rim = int(core_mask.sum()), int((~core_mask).sum())
     if n_core < (p + 1) * (q + 1):
+        left_out = int((found & not_core).sum())
+        why = (
+            f"; {left_out} of the {int(found.sum())} core candidates are hard or weighted "
+            "points (weight other than 1), which are never core points"
+            if left_out
+            else ""
+        )
         raise OptionsError(
             f"{LABEL}: option 'degree_u'/'degree_v': the core has {n_core} points, too few to skin "
-            f"a surface of degrees ({p}, {q}) (it needs at least {(p + 1) * (q + 1)})"
+            f"a surface of degrees ({p}, {q}) (it needs at least {(p + 1) * (q + 1)}){why}"
         )
     if n_rim == 0:
         raise OptionsError(f"{LABEL}: every point is in the core; use method='skinning'")

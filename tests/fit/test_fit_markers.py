@@ -286,3 +286,28 @@ def test_a_marker_beside_a_core_point_off_its_slope_is_met_and_noted() -> None:
                          marker_weight="hard")  # fmt: skip
     assert benign.report is not None
     assert not any("core's slope" in note for note in benign.report.notes)
+
+
+def test_weighted_markers_are_never_core_points() -> None:
+    """The density-found core interpolates its points: a weighted marker among them would be
+    met exactly (against its weight) and bend the core; it is data for the correction instead."""
+    points = geobrep.datasets.scattered_points()
+    core = points.vertices[points.point_data["core"].values == 1]
+    target = core[np.argmin(np.linalg.norm(core[:, :2] - core[:, :2].mean(axis=0), axis=1))]
+    head = target + np.array([0.5, 0.0, 50.01])  # 0.5 m beside a core point, 1 cm above it
+    well = Well(name="V", head=head, vertices=[head, head - [0.0, 0.0, 100.0]], md=[0.0, 100.0],
+                markers=[WellMarker(name="top", md=50.0, surface="dome")])  # fmt: skip
+    plain = geobrep.fit(points, method="hybrid", epsilon=0.5)
+    weighted = geobrep.fit(points, method="hybrid", epsilon=0.5, markers=[well],
+                           marker_weight=100.0)  # fmt: skip
+    assert plain.report is not None
+    assert weighted.report is not None
+    assert weighted.report.subsets["core"].n == plain.report.subsets["core"].n
+    assert weighted.report.subsets["core"].max_abs < 1e-6
+    assert weighted.report.details["core_points_corrected"]["least_squares"] >= 1
+    from geobrep.plugins.fit.distance import surface_distances
+
+    where = well.marker_positions()
+    before = abs(surface_distances(plain.surface, where)[0])
+    after = abs(surface_distances(weighted.surface, where)[0])
+    assert after < before / 5, (before, after)  # pulled towards the marker, the core kept
