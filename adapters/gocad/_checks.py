@@ -57,7 +57,7 @@ def _flat(xyz: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.bool
     u = columns[:, faces[:, 1]] - p0
     v = columns[:, faces[:, 2]] - p0
     with np.errstate(over="ignore", invalid="ignore"):
-        zero = (u[1] * v[2] - u[2] * v[1]) == 0
+        zero: NDArray[np.bool_] = (u[1] * v[2] - u[2] * v[1]) == 0
         zero &= (u[2] * v[0] - u[0] * v[2]) == 0
         zero &= (u[0] * v[1] - u[1] * v[0]) == 0
     return zero
