@@ -14,11 +14,19 @@ from typing import NamedTuple
 import numpy as np
 
 from geobrep.geometry import mesh
-from geobrep.geometry.arrays import FloatArray, IntArray
+from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.model.entities import Block, Surface
 from geobrep.model.scene import RELATIVE_MERGE_TOLERANCE, Scene
 
-__all__ = ["Shell", "block_shells"]
+__all__ = [
+    "PatchEdges",
+    "Shell",
+    "block_shell",
+    "block_shells",
+    "open_edges_if_one_way",
+    "patch_edges",
+    "patch_triangles",
+]
 
 
 class Shell(NamedTuple):
@@ -29,7 +37,7 @@ class Shell(NamedTuple):
     patch_labels: IntArray
 
 
-def _patch_triangles(scene: Scene, blocks: list[Block]) -> tuple[FloatArray, dict[int, IntArray]]:
+def patch_triangles(scene: Scene, blocks: list[Block]) -> tuple[FloatArray, dict[int, IntArray]]:
     """All the surfaces' vertices (joined) and each listed patch's triangles in their ids."""
     surfaces: dict[int, Surface] = {}
     for block in blocks:
@@ -67,32 +75,139 @@ def _patch_triangles(scene: Scene, blocks: list[Block]) -> tuple[FloatArray, dic
     points, inverse = mesh.merge_close_vertices(vertices[used], tolerance)
     renumber = np.full(total, -1, dtype=np.int64)
     renumber[used] = inverse
-    triangles_of = {
-        patch.id: renumber[by_patch[(patch.surface, patch.label)]]
-        for patch in scene.topology.patches
-        if (patch.surface, patch.label) in by_patch
-    }
+    triangles_of = {}
+    for patch in scene.topology.patches:
+        if (patch.surface, patch.label) in by_patch:
+            triangles = renumber[by_patch[(patch.surface, patch.label)]]
+            a, b, c = triangles.T
+            # the triangles the joining collapses are no part of any shell
+            triangles_of[patch.id] = triangles[(a != b) & (b != c) & (a != c)]
     return points, triangles_of
+
+
+def block_shell(points: FloatArray, triangles_of: dict[int, IntArray], block: Block) -> Shell:
+    """One block's boundary from the joined patch triangles."""
+    internal = block.internal_patches
+    pieces: list[IntArray] = []
+    labels: list[IntArray] = []
+    for patch_id, side in block.sides:
+        if patch_id in internal:
+            continue
+        triangles = triangles_of[patch_id]
+        pieces.append(mesh.flip_faces(triangles) if side == 1 else triangles)
+        labels.append(np.full(triangles.shape[0], len(labels), dtype=np.int64))
+    used, compact = mesh.compact_indices(np.concatenate(pieces), int(points.shape[0]))
+    return Shell(points[used], compact, np.concatenate(labels))
 
 
 def block_shells(scene: Scene, blocks: list[Block]) -> Iterator[Shell]:
     """The boundary of each of ``blocks`` as :meth:`Scene.block_mesh` builds it (faces flipped
     where the block is on a patch's positive side, patches listed with both sides left out,
     triangles the joining collapses dropped, one patch label per boundary side), in order."""
-    points, triangles_of = _patch_triangles(scene, blocks)
-    n = int(points.shape[0])
+    points, triangles_of = patch_triangles(scene, blocks)
     for block in blocks:
-        internal = block.internal_patches
-        pieces: list[IntArray] = []
-        labels: list[IntArray] = []
-        for patch_id, side in block.sides:
-            if patch_id in internal:
-                continue
-            triangles = triangles_of[patch_id]
-            pieces.append(mesh.flip_faces(triangles) if side == 1 else triangles)
-            labels.append(np.full(triangles.shape[0], len(labels), dtype=np.int64))
-        faces = np.concatenate(pieces)
-        a, b, c = faces.T
-        keep = (a != b) & (b != c) & (a != c)
-        used, compact = mesh.compact_indices(faces[keep], n)
-        yield Shell(points[used], compact, np.concatenate(labels)[keep])
+        yield block_shell(points, triangles_of, block)
+
+
+class PatchEdges(NamedTuple):
+    """How the joined triangles of every patch use their edges, for checking many shells at
+    once: an edge only one patch has ("own") decides alone whether a shell through that patch
+    runs one way there and is closed there; the edges several patches share are listed.
+
+    Patches are numbered by ``position`` (patch id -> index). ``own_conflict[i]``: an own edge
+    of patch ``i`` is used twice in one direction; ``own_open[i]``: its own edges used by one
+    triangle. ``shared_*`` (CSR by patch, ``shared_offsets``): each shared edge's key and how
+    many triangles of the patch use it from its lower vertex (``forward``) and the other way.
+    """
+
+    position: dict[int, int]
+    own_conflict: BoolArray
+    own_open: IntArray
+    shared_offsets: IntArray
+    shared_key: IntArray
+    shared_forward: IntArray
+    shared_backward: IntArray
+
+
+def patch_edges(triangles_of: dict[int, IntArray], n_points: int) -> PatchEdges | None:
+    """:class:`PatchEdges` of the joined patch triangles (one sort of one key per triangle
+    side); None when the keys would not fit an int64."""
+    ids = list(triangles_of)
+    n_patches = max(len(ids), 1)
+    n = max(n_points, 1)
+    if float(n) * n * n_patches * 2 >= 2.0**62:
+        return None
+    counts = np.array([triangles_of[i].shape[0] for i in ids], dtype=np.int64)
+    triangles = (
+        np.concatenate([triangles_of[i] for i in ids]) if ids else np.zeros((0, 3), np.int64)
+    )
+    start = triangles.reshape(-1)
+    end = triangles[:, [1, 2, 0]].reshape(-1)
+    patch = np.repeat(np.repeat(np.arange(len(ids), dtype=np.int64), counts), 3)
+    edge = np.minimum(start, end) * n + np.maximum(start, end)
+    keys, uses = np.unique(((edge * n_patches + patch) << 1) | (start > end), return_counts=True)
+    backward = (keys & 1).astype(np.bool_)
+    pair = keys >> 1  # edge * n_patches + patch
+    new_row = np.ones(pair.shape[0], dtype=np.bool_)
+    new_row[1:] = pair[1:] != pair[:-1]
+    row = np.cumsum(new_row) - 1
+    n_rows = int(row[-1]) + 1 if row.size else 0
+    forward_uses = np.zeros(n_rows, dtype=np.int64)
+    backward_uses = np.zeros(n_rows, dtype=np.int64)
+    forward_uses[row[~backward]] = uses[~backward]
+    backward_uses[row[backward]] = uses[backward]
+    row_pair = pair[new_row]
+    row_edge, row_patch = row_pair // n_patches, row_pair % n_patches
+    new_edge = np.ones(n_rows, dtype=np.bool_)
+    new_edge[1:] = row_edge[1:] != row_edge[:-1]
+    group = np.cumsum(new_edge) - 1
+    shared = np.bincount(group)[group] > 1 if n_rows else np.zeros(0, dtype=np.bool_)
+    own = ~shared
+    conflict = (forward_uses > 1) | (backward_uses > 1)
+    single = (forward_uses + backward_uses) == 1
+    own_conflict = np.bincount(row_patch[own & conflict], minlength=len(ids)) > 0
+    own_open = np.bincount(row_patch[own & single], minlength=len(ids)).astype(np.int64)
+    rows = np.flatnonzero(shared)
+    rows = rows[np.argsort(row_patch[rows], kind="stable")]
+    offsets = np.zeros(len(ids) + 1, dtype=np.int64)
+    np.cumsum(np.bincount(row_patch[rows], minlength=len(ids)), out=offsets[1:])
+    return PatchEdges(
+        position={patch_id: k for k, patch_id in enumerate(ids)},
+        own_conflict=own_conflict,
+        own_open=own_open,
+        shared_offsets=offsets,
+        shared_key=row_edge[rows],
+        shared_forward=forward_uses[rows],
+        shared_backward=backward_uses[rows],
+    )
+
+
+def open_edges_if_one_way(edges: PatchEdges, block: Block) -> int | None:
+    """The number of edges of ``block``'s shell used by one triangle when every edge of the
+    shell is used at most once in each direction (the shell runs one way: no triangle to
+    flip), else None."""
+    internal = block.internal_patches
+    sides = [(edges.position[p], side) for p, side in block.sides if p not in internal]
+    where = np.array([k for k, _ in sides], dtype=np.int64)
+    if edges.own_conflict[where].any():
+        return None
+    keys: list[IntArray] = []
+    forward: list[IntArray] = []
+    backward: list[IntArray] = []
+    bounds = edges.shared_offsets
+    for k, side in sides:
+        lo, hi = int(bounds[k]), int(bounds[k + 1])
+        keys.append(edges.shared_key[lo:hi])
+        ahead, back = edges.shared_forward[lo:hi], edges.shared_backward[lo:hi]
+        forward.append(back if side == 1 else ahead)  # the positive side is flipped
+        backward.append(ahead if side == 1 else back)
+    open_edges = int(edges.own_open[where].sum())
+    key = np.concatenate(keys)
+    if key.size:
+        _, inverse = np.unique(key, return_inverse=True)
+        ahead_total = np.bincount(inverse, weights=np.concatenate(forward))
+        back_total = np.bincount(inverse, weights=np.concatenate(backward))
+        if (ahead_total > 1).any() or (back_total > 1).any():
+            return None
+        open_edges += int(((ahead_total + back_total) == 1).sum())
+    return open_edges
