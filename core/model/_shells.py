@@ -145,40 +145,47 @@ def patch_edges(triangles_of: dict[int, IntArray], n_points: int) -> PatchEdges 
     end = triangles[:, [1, 2, 0]].reshape(-1)
     patch = np.repeat(np.repeat(np.arange(len(ids), dtype=np.int64), counts), 3)
     edge = np.minimum(start, end) * n + np.maximum(start, end)
-    keys, uses = np.unique(((edge * n_patches + patch) << 1) | (start > end), return_counts=True)
-    backward = (keys & 1).astype(np.bool_)
-    pair = keys >> 1  # edge * n_patches + patch
-    new_row = np.ones(pair.shape[0], dtype=np.bool_)
-    new_row[1:] = pair[1:] != pair[:-1]
-    row = np.cumsum(new_row) - 1
-    n_rows = int(row[-1]) + 1 if row.size else 0
-    forward_uses = np.zeros(n_rows, dtype=np.int64)
-    backward_uses = np.zeros(n_rows, dtype=np.int64)
-    forward_uses[row[~backward]] = uses[~backward]
-    backward_uses[row[backward]] = uses[backward]
-    row_pair = pair[new_row]
-    row_edge, row_patch = row_pair // n_patches, row_pair % n_patches
-    new_edge = np.ones(n_rows, dtype=np.bool_)
-    new_edge[1:] = row_edge[1:] != row_edge[:-1]
-    group = np.cumsum(new_edge) - 1
-    shared = np.bincount(group)[group] > 1 if n_rows else np.zeros(0, dtype=np.bool_)
+    # one key per triangle side: (edge, patch, direction), sorted
+    ordered = np.sort(((edge * n_patches + patch) << 1) | (start > end))
+    pair = ordered >> 1  # edge * n_patches + patch
+    edge = pair // n_patches
+    patch = pair - edge * n_patches
+    same_pair = pair[1:] == pair[:-1]
+    same_edge = edge[1:] == edge[:-1]
+    # an edge is shared when its run of sides holds two patches
+    edge_start = np.ones(ordered.shape[0], dtype=np.bool_)
+    np.logical_not(same_edge, out=edge_start[1:])
+    run = np.cumsum(edge_start) - 1
+    shared_run = np.zeros(int(run[-1]) + 1 if run.size else 0, dtype=np.bool_)
+    shared_run[run[1:][same_edge & ~same_pair]] = True
+    shared = shared_run[run]
     own = ~shared
-    conflict = (forward_uses > 1) | (backward_uses > 1)
-    single = (forward_uses + backward_uses) == 1
-    own_conflict = np.bincount(row_patch[own & conflict], minlength=len(ids)) > 0
-    own_open = np.bincount(row_patch[own & single], minlength=len(ids)).astype(np.int64)
-    rows = np.flatnonzero(shared)
-    rows = rows[np.argsort(row_patch[rows], kind="stable")]
+    # own edges: used twice one way (the same key twice), or by one triangle (a lone key)
+    twice = np.zeros(ordered.shape[0], dtype=np.bool_)
+    twice[1:] = ordered[1:] == ordered[:-1]
+    lone = np.ones(ordered.shape[0], dtype=np.bool_)
+    lone[1:] &= ~same_pair
+    lone[:-1] &= ~same_pair
+    own_conflict = np.bincount(patch[own & twice], minlength=len(ids)) > 0
+    own_open = np.bincount(patch[own & lone], minlength=len(ids)).astype(np.int64)
+    # shared edges: how often each patch uses them each way, by patch
+    sides = np.flatnonzero(shared)
+    rows, row_of = np.unique(pair[sides], return_inverse=True)
+    backward = (ordered[sides] & 1).astype(np.bool_)
+    row_forward = np.bincount(row_of[~backward], minlength=rows.shape[0]).astype(np.int64)
+    row_backward = np.bincount(row_of[backward], minlength=rows.shape[0]).astype(np.int64)
+    row_edge, row_patch = rows // n_patches, rows % n_patches
+    by_patch = np.argsort(row_patch, kind="stable")
     offsets = np.zeros(len(ids) + 1, dtype=np.int64)
-    np.cumsum(np.bincount(row_patch[rows], minlength=len(ids)), out=offsets[1:])
+    np.cumsum(np.bincount(row_patch, minlength=len(ids)), out=offsets[1:])
     return PatchEdges(
         position={patch_id: k for k, patch_id in enumerate(ids)},
         own_conflict=own_conflict,
         own_open=own_open,
         shared_offsets=offsets,
-        shared_key=row_edge[rows],
-        shared_forward=forward_uses[rows],
-        shared_backward=backward_uses[rows],
+        shared_key=row_edge[by_patch],
+        shared_forward=row_forward[by_patch],
+        shared_backward=row_backward[by_patch],
     )
 
 
