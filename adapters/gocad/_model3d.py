@@ -154,10 +154,10 @@ def attach_model3d(
     if options.repair:
         surfaces = _orient_by_key_triangles(surfaces, matched.key_faces, matched.patches, builder)
     blocks, region_block = _region_blocks(header, matched, first_id, builder)
-    patches = _with_blocks(matched.patches, blocks)
-    groups = _groups(header.lists, region_block, patches, builder)
+    sides = _with_blocks(matched.patches, blocks)
+    groups = _groups(header.lists, region_block, matched.patches, builder)
     topology = _rebuilt_topology(
-        surfaces, patches, options.merge_tolerance_for(diagonal), builder.warn
+        surfaces, matched.patches, options.merge_tolerance_for(diagonal), builder.warn, sides
     )
     return Model3dParts(topology, blocks, groups, _model_metadata(model), surfaces)
 
@@ -338,20 +338,18 @@ def _region_blocks(
     return blocks, region_block
 
 
-def _with_blocks(patches: list[Patch], blocks: list[Entity]) -> list[Patch]:
-    """The patches with the first block on each of their sides."""
+def _with_blocks(patches: list[Patch], blocks: list[Entity]) -> dict[int, dict[str, Any]]:
+    """The first block on each side of every patch, as updates of the patches."""
     positive: dict[int, int] = {}
     negative: dict[int, int] = {}
     for block in blocks:
         assert isinstance(block, Block)
         for patch_id, side in block.sides:
             (positive if side == 1 else negative).setdefault(patch_id, int(block.id or 0))
-    return [
-        p.model_copy(
-            update={"positive_block": positive.get(p.id), "negative_block": negative.get(p.id)}
-        )
+    return {
+        p.id: {"positive_block": positive.get(p.id), "negative_block": negative.get(p.id)}
         for p in patches
-    ]
+    }
 
 
 def _rebuilt_topology(
@@ -359,8 +357,10 @@ def _rebuilt_topology(
     patches: list[Patch],
     tolerance: float,
     warn: Callable[[str], None] | None,
+    updates: dict[int, dict[str, Any]] | None = None,
 ) -> Topology:
-    """Corners and arcs rebuilt from the patches (BSTONEs as extra corners) around them."""
+    """Corners and arcs rebuilt from the patches (BSTONEs as extra corners) around them; each
+    patch is copied once, with its arcs and its ``updates`` (the blocks on its sides)."""
     corners, arcs, patch_arcs = corners_and_arcs(
         {int(s.id or 0): s for s in surfaces}, patches, tolerance, _bstone_points(surfaces)
     )
@@ -370,7 +370,10 @@ def _rebuilt_topology(
         corners=tuple(corners),
         arcs=tuple(arcs),
         patches=tuple(
-            p.model_copy(update={"arcs": tuple(patch_arcs.get(p.id, ()))}) for p in patches
+            p.model_copy(
+                update={"arcs": tuple(patch_arcs.get(p.id, ())), **(updates or {}).get(p.id, {})}
+            )
+            for p in patches
         ),
     )
 

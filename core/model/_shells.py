@@ -52,7 +52,8 @@ def patch_triangles(scene: Scene, blocks: list[Block]) -> tuple[FloatArray, dict
     for surface_id, surface in surfaces.items():
         offsets[surface_id] = total
         total += surface.n_vertices
-    by_patch: dict[tuple[int, int], IntArray] = {}
+    sorted_triangles: list[IntArray] = []
+    label_bounds: list[IntArray] = []
     for surface_id, surface in surfaces.items():
         triangles, source = mesh.triangulate(surface.faces)
         labels = (
@@ -61,27 +62,32 @@ def patch_triangles(scene: Scene, blocks: list[Block]) -> tuple[FloatArray, dict
             else np.asarray(surface.patch_labels, dtype=np.int64)[source]
         )
         order = np.argsort(labels, kind="stable")
-        bounds = np.searchsorted(labels[order], np.arange(surface.n_patches + 1))
-        shifted = triangles.astype(np.int64)[order] + offsets[surface_id]
-        for label in range(surface.n_patches):
-            by_patch[(surface_id, label)] = shifted[bounds[label] : bounds[label + 1]]
+        label_bounds.append(np.searchsorted(labels[order], np.arange(surface.n_patches + 1)))
+        sorted_triangles.append(triangles.astype(np.int64)[order] + offsets[surface_id])
     vertices = np.concatenate([s.vertices for s in surfaces.values()] or [np.zeros((0, 3))])
-    gathered = [by_patch[key] for key in by_patch]
-    used, _ = mesh.compact_indices(
-        np.concatenate(gathered) if gathered else np.zeros((0, 3), np.int64), total
-    )
+    every = np.concatenate(sorted_triangles) if sorted_triangles else np.zeros((0, 3), np.int64)
+    used, _ = mesh.compact_indices(every, total)
     box = scene.bounds
     tolerance = RELATIVE_MERGE_TOLERANCE * (box.diagonal if box else 1.0)
     points, inverse = mesh.merge_close_vertices(vertices[used], tolerance)
     renumber = np.full(total, -1, dtype=np.int64)
     renumber[used] = inverse
-    triangles_of = {}
-    for patch in scene.topology.patches:
-        if (patch.surface, patch.label) in by_patch:
-            triangles = renumber[by_patch[(patch.surface, patch.label)]]
-            a, b, c = triangles.T
-            # the triangles the joining collapses are no part of any shell
-            triangles_of[patch.id] = triangles[(a != b) & (b != c) & (a != c)]
+    # each surface's triangles renumbered once; the triangles the joining collapses are no
+    # part of any shell; each label keeps a slice of the rest
+    by_patch: dict[tuple[int, int], IntArray] = {}
+    for surface_id, triangles, bounds in zip(surfaces, sorted_triangles, label_bounds, strict=True):
+        joined = renumber[triangles]
+        a, b, c = joined[:, 0], joined[:, 1], joined[:, 2]
+        keep = (a != b) & (b != c) & (a != c)
+        kept = joined[keep]
+        kept_bounds = np.concatenate([[0], np.cumsum(keep)])[bounds].tolist()
+        for label in range(bounds.shape[0] - 1):
+            by_patch[(surface_id, label)] = kept[kept_bounds[label] : kept_bounds[label + 1]]
+    triangles_of = {
+        patch.id: by_patch[(patch.surface, patch.label)]
+        for patch in scene.topology.patches
+        if (patch.surface, patch.label) in by_patch
+    }
     return points, triangles_of
 
 
