@@ -73,6 +73,7 @@ def bad_triangles(xyz: NDArray[np.float64], faces: NDArray[np.int64]) -> BadTria
     """
     if faces.shape[0] == 0:
         return None
+    faces = np.asarray(faces, dtype=np.int64)  # the keys need 64 bits
     n = xyz.shape[0]
     flat = _flat(xyz, faces)
     keys = _triangle_keys(faces, n)
@@ -100,6 +101,8 @@ def borders_on_patch_borders(
     >>> borders_on_patch_borders(faces, np.array([0, 0]), np.array([[1, 0], [0, 2]])).tolist()
     [True, False]
     """
+    faces = np.asarray(faces, dtype=np.int64)  # the keys need 64 bits
+    pairs = np.asarray(pairs, dtype=np.int64)
     n = int(max(faces.max(initial=0), pairs.max(initial=0))) + 1
     on_line = np.zeros(n, dtype=bool)
     on_line[pairs.reshape(-1)] = True

@@ -68,3 +68,15 @@ def test_borders_on_patch_borders_as_defined(seed: int) -> None:
     assert borders_on_patch_borders(faces, parts, pairs).tolist() == expected
     assert any(expected)
     assert not all(expected)
+
+
+def test_32_bit_indices_give_the_same_answers() -> None:
+    xyz, faces, parts = _soup(9)
+    xyz = np.concatenate([xyz, np.random.default_rng(9).normal(size=(70_000, 3))])
+    faces = faces + 69_990  # keys beyond 32 bits: (70k)^3
+    assert bad_triangles(xyz, faces.astype(np.int32)) == bad_triangles(xyz, faces)
+    pairs = faces[:5, :2]
+    assert (
+        borders_on_patch_borders(faces.astype(np.int32), parts, pairs.astype(np.int32)).tolist()
+        == borders_on_patch_borders(faces, parts, pairs).tolist()
+    )
