@@ -67,18 +67,63 @@ def find_key_triangle(
     opposite order matches. ``(None, False)`` when no triangle matches.
     """
     faces = surface.patch_faces(label)
+    return _match_key(faces, surface.faces[faces][:, :3], surface.vertices, key, tolerance)
+
+
+def _match_key(
+    faces: NDArray[np.int64],
+    corners: NDArray[np.integer[Any]],
+    vertices: NDArray[np.float64],
+    key: NDArray[np.float64],
+    tolerance: float,
+) -> tuple[int | None, bool]:
+    """:func:`find_key_triangle` among ``faces`` (their first three vertices ``corners``): a
+    corner matches a key point when each coordinate is within ``tolerance``; the faces whose
+    first corner matches are found first, and only those are checked whole."""
     if faces.size == 0:
         return None, False
-    corners = surface.vertices[surface.faces[faces][:, :3]]  # (m, 3, 3)
+    first = vertices[corners[:, 0]]
+    near_first: dict[int, NDArray[np.int64]] = {}
     for reverse in (False, True):
-        target = key[::-1] if reverse else key
         for shift in range(3):
-            rolled = np.roll(target, shift, axis=0)
-            close = (np.abs(corners - rolled[None]) <= tolerance).all(axis=(1, 2))
-            hit = np.flatnonzero(close)
+            # corner j of the face against target[(j - shift) % 3], target = key (reversed)
+            which = [(j - shift) % 3 for j in range(3)]
+            if reverse:
+                which = [2 - w for w in which]
+            if which[0] not in near_first:
+                close = (np.abs(first - key[which[0]]) <= tolerance).all(axis=1)
+                near_first[which[0]] = np.flatnonzero(close)
+            hit = near_first[which[0]]
+            for j in (1, 2):
+                if not hit.size:
+                    break
+                at = vertices[corners[hit, j]]
+                hit = hit[(np.abs(at - key[which[j]]) <= tolerance).all(axis=1)]
             if hit.size:
                 return int(faces[hit[0]]), reverse
     return None, False
+
+
+class _PatchCorners:
+    """Each patch's faces (ascending) and their first three vertices, for one surface."""
+
+    def __init__(self, surface: Surface) -> None:
+        labels = (
+            np.zeros(surface.n_faces, dtype=np.int64)
+            if surface.patch_labels is None
+            else np.asarray(surface.patch_labels, dtype=np.int64)
+        )
+        self.vertices = surface.vertices
+        self.order = np.argsort(labels, kind="stable").astype(np.int64)
+        self.bounds = np.searchsorted(labels[self.order], np.arange(surface.n_patches + 1))
+        self.corners = surface.faces[self.order][:, :3]
+
+    def find(
+        self, label: int, key: NDArray[np.float64], tolerance: float
+    ) -> tuple[int | None, bool]:
+        """:func:`find_key_triangle` of patch ``label``."""
+        lo, hi = int(self.bounds[label]), int(self.bounds[label + 1])
+        return _match_key(self.order[lo:hi], self.corners[lo:hi], self.vertices, key, tolerance)
 
 
 def _tsurf_names(surface: Surface) -> list[str]:
@@ -109,10 +154,10 @@ def attach_model3d(
     if options.repair:
         surfaces = _orient_by_key_triangles(surfaces, matched.key_faces, matched.patches, builder)
     blocks, region_block = _region_blocks(header, matched, first_id, builder)
-    patches = _with_blocks(matched.patches, blocks)
-    groups = _groups(header.lists, region_block, patches, builder)
+    sides = _with_blocks(matched.patches, blocks)
+    groups = _groups(header.lists, region_block, matched.patches, builder)
     topology = _rebuilt_topology(
-        surfaces, patches, options.merge_tolerance_for(diagonal), builder.warn
+        surfaces, matched.patches, options.merge_tolerance_for(diagonal), builder.warn, sides
     )
     return Model3dParts(topology, blocks, groups, _model_metadata(model), surfaces)
 
@@ -147,6 +192,7 @@ class _TFaceMatcher:
     flipped: dict[int, bool] = field(default_factory=dict)  # TFACE id -> key triangle reversed
     key_faces: dict[int, dict[int, int | None]] = field(default_factory=dict)
     """surface id -> patch label -> face index of its key triangle (None: not found)."""
+    _corners: dict[int, _PatchCorners] = field(default_factory=dict)
 
     def match_all(self, header: Model3dHeader) -> None:
         by_name: dict[str, Surface] = {}
@@ -198,7 +244,10 @@ class _TFaceMatcher:
             )
         key = np.asarray(entry.key, dtype=np.float64)
         key[:, 2] *= self.z_sign
-        face, reverse = find_key_triangle(surface, label, key, self.key_tolerance)
+        sid = int(surface.id or 0)
+        if sid not in self._corners:
+            self._corners[sid] = _PatchCorners(surface)
+        face, reverse = self._corners[sid].find(label, key, self.key_tolerance)
         if face is None:
             self.builder.warn(
                 f"the key triangle of TFACE {entry.id} is not a triangle of part {label + 1} "
@@ -289,20 +338,18 @@ def _region_blocks(
     return blocks, region_block
 
 
-def _with_blocks(patches: list[Patch], blocks: list[Entity]) -> list[Patch]:
-    """The patches with the first block on each of their sides."""
+def _with_blocks(patches: list[Patch], blocks: list[Entity]) -> dict[int, dict[str, Any]]:
+    """The first block on each side of every patch, as updates of the patches."""
     positive: dict[int, int] = {}
     negative: dict[int, int] = {}
     for block in blocks:
         assert isinstance(block, Block)
         for patch_id, side in block.sides:
             (positive if side == 1 else negative).setdefault(patch_id, int(block.id or 0))
-    return [
-        p.model_copy(
-            update={"positive_block": positive.get(p.id), "negative_block": negative.get(p.id)}
-        )
+    return {
+        p.id: {"positive_block": positive.get(p.id), "negative_block": negative.get(p.id)}
         for p in patches
-    ]
+    }
 
 
 def _rebuilt_topology(
@@ -310,8 +357,10 @@ def _rebuilt_topology(
     patches: list[Patch],
     tolerance: float,
     warn: Callable[[str], None] | None,
+    updates: dict[int, dict[str, Any]] | None = None,
 ) -> Topology:
-    """Corners and arcs rebuilt from the patches (BSTONEs as extra corners) around them."""
+    """Corners and arcs rebuilt from the patches (BSTONEs as extra corners) around them; each
+    patch is copied once, with its arcs and its ``updates`` (the blocks on its sides)."""
     corners, arcs, patch_arcs = corners_and_arcs(
         {int(s.id or 0): s for s in surfaces}, patches, tolerance, _bstone_points(surfaces)
     )
@@ -321,7 +370,10 @@ def _rebuilt_topology(
         corners=tuple(corners),
         arcs=tuple(arcs),
         patches=tuple(
-            p.model_copy(update={"arcs": tuple(patch_arcs.get(p.id, ()))}) for p in patches
+            p.model_copy(
+                update={"arcs": tuple(patch_arcs.get(p.id, ())), **(updates or {}).get(p.id, {})}
+            )
+            for p in patches
         ),
     )
 

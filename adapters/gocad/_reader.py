@@ -21,6 +21,7 @@ from typing import Any, TypedDict
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.adapters.gocad._checks import bad_triangles, borders_on_patch_borders
 from geobrep.adapters.gocad._headers import PropertyHeader, color_from_text
 from geobrep.adapters.gocad._lexer import Source
 from geobrep.adapters.gocad._objects import gocad_section
@@ -390,22 +391,14 @@ class _Builder:
         """One warning per TSurf with duplicated triangles (the three vertices of an earlier
         TRGL, in any order) or zero-area ones (a repeated vertex, or three collinear points);
         the triangles are kept as read."""
-        if faces.shape[0] == 0:
-            return
-        duplicated = np.ones(faces.shape[0], dtype=bool)
-        duplicated[_first_of_each_triangle(faces, xyz.shape[0])] = False
-        corners = xyz[faces]
-        with np.errstate(over="ignore", invalid="ignore"):
-            normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-        flat = ~(normals != 0).any(axis=1)  # NaN from overflow is not "zero area"
-        bad = duplicated | flat
-        if not bad.any():
+        bad = bad_triangles(xyz, faces)
+        if bad is None:
             return
         self.warn(
-            f"TSurf {obj.name!r}: {int(duplicated.sum())} duplicated triangle(s) (the same "
-            f"three vertices as an earlier TRGL) and {int(flat.sum())} zero-area triangle(s) "
+            f"TSurf {obj.name!r}: {bad.duplicated} duplicated triangle(s) (the same "
+            f"three vertices as an earlier TRGL) and {bad.flat} zero-area triangle(s) "
             "(the first on this line); kept as read",
-            int(lines[int(np.argmax(bad))]),
+            int(lines[bad.first]),
         )
 
     def _warn_inner_borders(
@@ -421,9 +414,7 @@ class _Builder:
         borders = fields["metadata"]["gocad"].get("borders")
         if not borders:
             return
-        pairs = np.asarray(borders, dtype=np.int64)
-        n = int(max(faces.max(initial=0), pairs.max())) + 1
-        on_border = np.isin(_edge_keys(pairs, n), _border_edges(faces, parts, n))
+        on_border = borders_on_patch_borders(faces, parts, np.asarray(borders, dtype=np.int64))
         if on_border.all():
             return
         first = int(np.argmin(on_border))
@@ -712,42 +703,6 @@ class _Builder:
                 },
             )
         )
-
-
-def _edge_keys(pairs: NDArray[np.int64], n: int) -> NDArray[np.int64]:
-    """``min * n + max`` of each vertex pair (rows of ``pairs``)."""
-    keys: NDArray[np.int64] = pairs.min(axis=1) * n + pairs.max(axis=1)
-    return keys
-
-
-def _first_of_each_triangle(faces: NDArray[np.int64], n: int) -> NDArray[np.int64]:
-    """Index of the first face of each set of three vertices (in any order)."""
-    ordered = np.sort(faces, axis=1)
-    if n <= 2_000_000:  # n**3 fits in int64: one key per face, a 1-D sort
-        keys = (ordered[:, 0] * n + ordered[:, 1]) * n + ordered[:, 2]
-        first: NDArray[np.int64] = np.unique(keys, return_index=True)[1]
-        return first
-    first = np.unique(ordered, axis=0, return_index=True)[1]
-    return first
-
-
-def _border_edges(faces: NDArray[np.int64], parts: NDArray[np.int64], n: int) -> NDArray[np.int64]:
-    """Keys (:func:`_edge_keys`) of the edges one triangle of a patch uses: the patches'
-    borders."""
-    if faces.size == 0:
-        return np.zeros(0, dtype=np.int64)
-    edges = faces[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2)
-    edge_keys = _edge_keys(edges, n)
-    n_parts = int(parts.max(initial=0)) + 1
-    if int(edge_keys.max()) < np.iinfo(np.int64).max // n_parts - n_parts:
-        # One int64 key per (patch, edge): a 1-D sort instead of a row-wise unique.
-        row_keys, counts = np.unique(edge_keys * n_parts + np.repeat(parts, 3), return_counts=True)
-        keys: NDArray[np.int64] = np.unique(row_keys[counts == 1] // n_parts)
-        return keys
-    rows = np.column_stack([np.repeat(parts, 3), edge_keys])
-    unique, counts = np.unique(rows, axis=0, return_counts=True)
-    keys = np.unique(unique[counts == 1, 1])
-    return keys
 
 
 def _majority_names(obj: GocadObject, component: NDArray[np.int64], count: int) -> list[str]:

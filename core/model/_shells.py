@@ -14,11 +14,19 @@ from typing import NamedTuple
 import numpy as np
 
 from geobrep.geometry import mesh
-from geobrep.geometry.arrays import FloatArray, IntArray
+from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.model.entities import Block, Surface
 from geobrep.model.scene import RELATIVE_MERGE_TOLERANCE, Scene
 
-__all__ = ["Shell", "block_shells"]
+__all__ = [
+    "PatchEdges",
+    "Shell",
+    "block_shell",
+    "block_shells",
+    "open_edges_if_one_way",
+    "patch_edges",
+    "patch_triangles",
+]
 
 
 class Shell(NamedTuple):
@@ -29,7 +37,7 @@ class Shell(NamedTuple):
     patch_labels: IntArray
 
 
-def _patch_triangles(scene: Scene, blocks: list[Block]) -> tuple[FloatArray, dict[int, IntArray]]:
+def patch_triangles(scene: Scene, blocks: list[Block]) -> tuple[FloatArray, dict[int, IntArray]]:
     """All the surfaces' vertices (joined) and each listed patch's triangles in their ids."""
     surfaces: dict[int, Surface] = {}
     for block in blocks:
@@ -44,7 +52,8 @@ def _patch_triangles(scene: Scene, blocks: list[Block]) -> tuple[FloatArray, dic
     for surface_id, surface in surfaces.items():
         offsets[surface_id] = total
         total += surface.n_vertices
-    by_patch: dict[tuple[int, int], IntArray] = {}
+    sorted_triangles: list[IntArray] = []
+    label_bounds: list[IntArray] = []
     for surface_id, surface in surfaces.items():
         triangles, source = mesh.triangulate(surface.faces)
         labels = (
@@ -53,46 +62,165 @@ def _patch_triangles(scene: Scene, blocks: list[Block]) -> tuple[FloatArray, dic
             else np.asarray(surface.patch_labels, dtype=np.int64)[source]
         )
         order = np.argsort(labels, kind="stable")
-        bounds = np.searchsorted(labels[order], np.arange(surface.n_patches + 1))
-        shifted = triangles.astype(np.int64)[order] + offsets[surface_id]
-        for label in range(surface.n_patches):
-            by_patch[(surface_id, label)] = shifted[bounds[label] : bounds[label + 1]]
+        label_bounds.append(np.searchsorted(labels[order], np.arange(surface.n_patches + 1)))
+        sorted_triangles.append(triangles.astype(np.int64)[order] + offsets[surface_id])
     vertices = np.concatenate([s.vertices for s in surfaces.values()] or [np.zeros((0, 3))])
-    gathered = [by_patch[key] for key in by_patch]
-    used, _ = mesh.compact_indices(
-        np.concatenate(gathered) if gathered else np.zeros((0, 3), np.int64), total
-    )
+    every = np.concatenate(sorted_triangles) if sorted_triangles else np.zeros((0, 3), np.int64)
+    used, _ = mesh.compact_indices(every, total)
     box = scene.bounds
     tolerance = RELATIVE_MERGE_TOLERANCE * (box.diagonal if box else 1.0)
     points, inverse = mesh.merge_close_vertices(vertices[used], tolerance)
     renumber = np.full(total, -1, dtype=np.int64)
     renumber[used] = inverse
+    # each surface's triangles renumbered once; the triangles the joining collapses are no
+    # part of any shell; each label keeps a slice of the rest
+    by_patch: dict[tuple[int, int], IntArray] = {}
+    for surface_id, triangles, bounds in zip(surfaces, sorted_triangles, label_bounds, strict=True):
+        joined = renumber[triangles]
+        a, b, c = joined[:, 0], joined[:, 1], joined[:, 2]
+        keep = (a != b) & (b != c) & (a != c)
+        kept = joined[keep]
+        kept_bounds = np.concatenate([[0], np.cumsum(keep)])[bounds].tolist()
+        for label in range(bounds.shape[0] - 1):
+            by_patch[(surface_id, label)] = kept[kept_bounds[label] : kept_bounds[label + 1]]
     triangles_of = {
-        patch.id: renumber[by_patch[(patch.surface, patch.label)]]
+        patch.id: by_patch[(patch.surface, patch.label)]
         for patch in scene.topology.patches
         if (patch.surface, patch.label) in by_patch
     }
     return points, triangles_of
 
 
+def block_shell(points: FloatArray, triangles_of: dict[int, IntArray], block: Block) -> Shell:
+    """One block's boundary from the joined patch triangles."""
+    internal = block.internal_patches
+    pieces: list[IntArray] = []
+    labels: list[IntArray] = []
+    for patch_id, side in block.sides:
+        if patch_id in internal:
+            continue
+        triangles = triangles_of[patch_id]
+        pieces.append(mesh.flip_faces(triangles) if side == 1 else triangles)
+        labels.append(np.full(triangles.shape[0], len(labels), dtype=np.int64))
+    used, compact = mesh.compact_indices(np.concatenate(pieces), int(points.shape[0]))
+    return Shell(points[used], compact, np.concatenate(labels))
+
+
 def block_shells(scene: Scene, blocks: list[Block]) -> Iterator[Shell]:
     """The boundary of each of ``blocks`` as :meth:`Scene.block_mesh` builds it (faces flipped
     where the block is on a patch's positive side, patches listed with both sides left out,
     triangles the joining collapses dropped, one patch label per boundary side), in order."""
-    points, triangles_of = _patch_triangles(scene, blocks)
-    n = int(points.shape[0])
+    points, triangles_of = patch_triangles(scene, blocks)
     for block in blocks:
-        internal = block.internal_patches
-        pieces: list[IntArray] = []
-        labels: list[IntArray] = []
-        for patch_id, side in block.sides:
-            if patch_id in internal:
-                continue
-            triangles = triangles_of[patch_id]
-            pieces.append(mesh.flip_faces(triangles) if side == 1 else triangles)
-            labels.append(np.full(triangles.shape[0], len(labels), dtype=np.int64))
-        faces = np.concatenate(pieces)
-        a, b, c = faces.T
-        keep = (a != b) & (b != c) & (a != c)
-        used, compact = mesh.compact_indices(faces[keep], n)
-        yield Shell(points[used], compact, np.concatenate(labels)[keep])
+        yield block_shell(points, triangles_of, block)
+
+
+class PatchEdges(NamedTuple):
+    """How the joined triangles of every patch use their edges, for checking many shells at
+    once: an edge only one patch has ("own") decides alone whether a shell through that patch
+    runs one way there and is closed there; the edges several patches share are listed.
+
+    Patches are numbered by ``position`` (patch id -> index). ``own_conflict[i]``: an own edge
+    of patch ``i`` is used twice in one direction; ``own_open[i]``: its own edges used by one
+    triangle. ``shared_*`` (CSR by patch, ``shared_offsets``): each shared edge's key and how
+    many triangles of the patch use it from its lower vertex (``forward``) and the other way.
+    """
+
+    position: dict[int, int]
+    own_conflict: BoolArray
+    own_open: IntArray
+    shared_offsets: IntArray
+    shared_key: IntArray
+    shared_forward: IntArray
+    shared_backward: IntArray
+
+
+def patch_edges(triangles_of: dict[int, IntArray], n_points: int) -> PatchEdges | None:
+    """:class:`PatchEdges` of the joined patch triangles (one sort of one key per triangle
+    side); None when the keys would not fit an int64."""
+    ids = list(triangles_of)
+    n_patches = max(len(ids), 1)
+    n = max(n_points, 1)
+    if float(n) * n * n_patches * 2 >= 2.0**62:
+        return None
+    counts = np.array([triangles_of[i].shape[0] for i in ids], dtype=np.int64)
+    triangles = (
+        np.concatenate([triangles_of[i] for i in ids]) if ids else np.zeros((0, 3), np.int64)
+    )
+    start = triangles.reshape(-1)
+    end = triangles[:, [1, 2, 0]].reshape(-1)
+    patch = np.repeat(np.repeat(np.arange(len(ids), dtype=np.int64), counts), 3)
+    edge = np.minimum(start, end) * n + np.maximum(start, end)
+    # one key per triangle side: (edge, patch, direction), sorted
+    ordered = np.sort(((edge * n_patches + patch) << 1) | (start > end))
+    pair = ordered >> 1  # edge * n_patches + patch
+    edge = pair // n_patches
+    patch = pair - edge * n_patches
+    same_pair = pair[1:] == pair[:-1]
+    same_edge = edge[1:] == edge[:-1]
+    # an edge is shared when its run of sides holds two patches
+    edge_start = np.ones(ordered.shape[0], dtype=np.bool_)
+    np.logical_not(same_edge, out=edge_start[1:])
+    run = np.cumsum(edge_start) - 1
+    shared_run = np.zeros(int(run[-1]) + 1 if run.size else 0, dtype=np.bool_)
+    shared_run[run[1:][same_edge & ~same_pair]] = True
+    shared = shared_run[run]
+    own = ~shared
+    # own edges: used twice one way (the same key twice), or by one triangle (a lone key)
+    twice = np.zeros(ordered.shape[0], dtype=np.bool_)
+    twice[1:] = ordered[1:] == ordered[:-1]
+    lone = np.ones(ordered.shape[0], dtype=np.bool_)
+    lone[1:] &= ~same_pair
+    lone[:-1] &= ~same_pair
+    own_conflict = np.bincount(patch[own & twice], minlength=len(ids)) > 0
+    own_open = np.bincount(patch[own & lone], minlength=len(ids)).astype(np.int64)
+    # shared edges: how often each patch uses them each way, by patch
+    sides = np.flatnonzero(shared)
+    rows, row_of = np.unique(pair[sides], return_inverse=True)
+    backward = (ordered[sides] & 1).astype(np.bool_)
+    row_forward = np.bincount(row_of[~backward], minlength=rows.shape[0]).astype(np.int64)
+    row_backward = np.bincount(row_of[backward], minlength=rows.shape[0]).astype(np.int64)
+    row_edge, row_patch = rows // n_patches, rows % n_patches
+    by_patch = np.argsort(row_patch, kind="stable")
+    offsets = np.zeros(len(ids) + 1, dtype=np.int64)
+    np.cumsum(np.bincount(row_patch, minlength=len(ids)), out=offsets[1:])
+    return PatchEdges(
+        position={patch_id: k for k, patch_id in enumerate(ids)},
+        own_conflict=own_conflict,
+        own_open=own_open,
+        shared_offsets=offsets,
+        shared_key=row_edge[by_patch],
+        shared_forward=row_forward[by_patch],
+        shared_backward=row_backward[by_patch],
+    )
+
+
+def open_edges_if_one_way(edges: PatchEdges, block: Block) -> int | None:
+    """The number of edges of ``block``'s shell used by one triangle when every edge of the
+    shell is used at most once in each direction (the shell runs one way: no triangle to
+    flip), else None."""
+    internal = block.internal_patches
+    sides = [(edges.position[p], side) for p, side in block.sides if p not in internal]
+    where = np.array([k for k, _ in sides], dtype=np.int64)
+    if edges.own_conflict[where].any():
+        return None
+    keys: list[IntArray] = []
+    forward: list[IntArray] = []
+    backward: list[IntArray] = []
+    bounds = edges.shared_offsets
+    for k, side in sides:
+        lo, hi = int(bounds[k]), int(bounds[k + 1])
+        keys.append(edges.shared_key[lo:hi])
+        ahead, back = edges.shared_forward[lo:hi], edges.shared_backward[lo:hi]
+        forward.append(back if side == 1 else ahead)  # the positive side is flipped
+        backward.append(ahead if side == 1 else back)
+    open_edges = int(edges.own_open[where].sum())
+    key = np.concatenate(keys)
+    if key.size:
+        _, inverse = np.unique(key, return_inverse=True)
+        ahead_total = np.bincount(inverse, weights=np.concatenate(forward))
+        back_total = np.bincount(inverse, weights=np.concatenate(backward))
+        if (ahead_total > 1).any() or (back_total > 1).any():
+            return None
+        open_edges += int(((ahead_total + back_total) == 1).sum())
+    return open_edges

@@ -49,7 +49,9 @@ from geobrep.errors import DegenerateGeometryError, TopologyError
 from geobrep.geometry import mesh
 from geobrep.geometry.arrays import BoolArray, IntArray
 from geobrep.geometry.bbox import column_extremes
-from geobrep.geometry.graph import component_roots, nearest_within, path_order
+from geobrep.geometry.graph import cell_hash, component_roots, nearest_within, path_order
+from geobrep.geometry.mesh import _PROJECTION_RTOL
+from geobrep.model.arrays import as_readonly
 from geobrep.model.entities import Surface
 from geobrep.model.scene import Scene
 from geobrep.model.topology import Arc, Corner, Patch, Topology
@@ -510,26 +512,39 @@ def build_corners_and_arcs(
 def _patch_triangles(
     surfaces: Mapping[int, Surface], patches: Sequence[Patch]
 ) -> tuple[NDArray[np.float64], IntArray, IntArray]:
-    """All vertices used by the patches, their triangles (global indices) and patch positions."""
+    """All vertices used by the patches, their triangles (global indices) and patch positions.
+
+    Each surface is triangulated and its triangles grouped by patch label once (a stable
+    sort: a patch's triangles keep the order of its faces)."""
     vertex_parts: list[NDArray[np.float64]] = []
-    offsets: dict[int, int] = {}
+    grouped: dict[int, tuple[IntArray, IntArray]] = {}  # surface id -> triangles, label bounds
     total = 0
     triangle_parts: list[IntArray] = []
-    owner_parts: list[IntArray] = []
+    counts = np.zeros(len(patches), dtype=np.int64)
     for position, patch in enumerate(patches):
         surface = surfaces.get(patch.surface)
         if surface is None:
             raise TopologyError(f"patch {patch.id}: entity {patch.surface} is not a Surface")
-        if patch.surface not in offsets:
-            offsets[patch.surface] = total
+        if not 0 <= patch.label < surface.n_patches:
+            surface.patch_faces(patch.label)  # raises the surface's own error
+        if patch.surface not in grouped:
             vertex_parts.append(np.asarray(surface.vertices, dtype=np.float64))
+            triangles, source = mesh.triangulate(surface.faces)
+            if surface.patch_labels is None:
+                labels = np.zeros(source.shape[0], dtype=np.int64)
+            else:
+                labels = np.asarray(surface.patch_labels, dtype=np.int64)[source]
+            order = np.argsort(labels, kind="stable")
+            bounds = np.searchsorted(labels[order], np.arange(surface.n_patches + 1))
+            grouped[patch.surface] = (triangles.astype(np.int64)[order] + total, bounds)
             total += surface.n_vertices
-        triangles, _ = mesh.triangulate(surface.faces[surface.patch_faces(patch.label)])
-        triangle_parts.append(triangles + offsets[patch.surface])
-        owner_parts.append(np.full(triangles.shape[0], position, dtype=np.int64))
+        triangles, bounds = grouped[patch.surface]
+        part = triangles[bounds[patch.label] : bounds[patch.label + 1]]
+        triangle_parts.append(part)
+        counts[position] = part.shape[0]
     vertices = np.concatenate(vertex_parts) if vertex_parts else np.zeros((0, 3))
     triangles = np.concatenate(triangle_parts) if triangle_parts else np.zeros((0, 3), np.int64)
-    owners = np.concatenate(owner_parts) if owner_parts else np.zeros(0, np.int64)
+    owners = np.repeat(np.arange(len(patches), dtype=np.int64), counts)
     return vertices, triangles.astype(np.int64), owners
 
 
@@ -563,6 +578,70 @@ def _around(
     return members
 
 
+def _patch_orders(
+    chains: ArcChains,
+    points: NDArray[np.float64],
+    tri: IntArray,
+    offsets: IntArray,
+    incident: IntArray,
+    sides: IntArray,
+    incident_patch: IntArray,
+) -> list[IntArray]:
+    """:func:`_around` of every arc: the right-hand order about each arc's first edge is
+    found for all arcs at once (the sort of :func:`geobrep.geometry.sort_around_axis`, arc by
+    arc); an arc whose first edge has a triangle along the axis is left to :func:`_around`."""
+    n_arcs = chains.n_arcs
+    first = chains.edge_ids[chains.arc_offsets[:-1]]
+    positions, arc_of = _segments(offsets, first)
+    count = np.diff(offsets)[first]
+    members = incident_patch[positions]
+    orders: list[IntArray] = np.split(members, np.cumsum(count)[:-1])
+    sorted_arcs = np.flatnonzero(count >= 2)
+    if not sorted_arcs.size:
+        return orders
+    keep = count[arc_of] >= 2
+    positions, arc_of = positions[keep], arc_of[keep]
+    start = points[chains.edge_start[chains.arc_offsets[:-1]]]
+    axis = points[chains.edge_end[chains.arc_offsets[:-1]]] - start
+    axis_length = np.sqrt(np.einsum("ij,ij->i", axis, axis))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = axis / axis_length[:, None]
+    thirds = tri[incident[positions], (sides[positions] + 2) % 3]
+    dirs = points[thirds] - start[arc_of]
+    ua = u[arc_of]
+    along = np.einsum("ij,ij->i", dirs, ua)
+    proj = dirs - along[:, None] * ua
+    proj_length = np.sqrt(np.einsum("ij,ij->i", proj, proj))
+    dir_length = np.sqrt(np.einsum("ij,ij->i", dirs, dirs))
+    bad = (proj_length <= _PROJECTION_RTOL * dir_length) | (dir_length == 0.0)
+    degenerate = np.zeros(n_arcs, dtype=np.bool_)
+    degenerate[arc_of[bad]] = True
+    degenerate |= ~(axis_length > 0.0)
+    # the reference direction of each arc: its first incident triangle
+    local_head = np.searchsorted(arc_of, np.arange(n_arcs))  # among the kept ones
+    with np.errstate(invalid="ignore", divide="ignore"):
+        e1 = proj[np.minimum(local_head, proj.shape[0] - 1)]
+        e1 = e1 / proj_length[np.minimum(local_head, proj.shape[0] - 1)][:, None]
+    e2 = np.cross(u, e1)
+    angles = np.arctan2(
+        np.einsum("ij,ij->i", proj, e2[arc_of]), np.einsum("ij,ij->i", proj, e1[arc_of])
+    )
+    is_head = np.zeros(positions.shape[0], dtype=np.bool_)
+    is_head[local_head[sorted_arcs]] = True
+    angles[is_head] = 0.0
+    angles = np.where(angles < 0.0, angles + 2.0 * np.pi, angles)
+    angles[angles >= 2.0 * np.pi] = 0.0
+    order = np.lexsort((angles, arc_of))
+    ordered = incident_patch[positions[order]]
+    bounds = np.cumsum(count[sorted_arcs])
+    for a, part in zip(sorted_arcs.tolist(), np.split(ordered, bounds[:-1]), strict=True):
+        if degenerate[a]:
+            orders[a] = _around(chains, a, points, tri, offsets, incident, sides, incident_patch)
+        else:
+            orders[a] = part
+    return orders
+
+
 def _nearest(points: NDArray[np.float64], queries: NDArray[np.float64], reach: float) -> IntArray:
     """The nearest of ``points`` to each query within ``reach`` (queries without one left
     out): a hashed grid, or scipy's k-d tree for a crowd of points closer than ``reach``."""
@@ -573,6 +652,45 @@ def _nearest(points: NDArray[np.float64], queries: NDArray[np.float64], reach: f
         distance, found = cKDTree(points).query(queries)
         nearest = np.where(distance <= reach, found, -1)
     return np.asarray(nearest[nearest >= 0], dtype=np.int64)
+
+
+def _exact_rows(points: NDArray[np.float64], queries: NDArray[np.float64]) -> IntArray:
+    """For each query, the index of the point with exactly its coordinates (``-0.0`` equal to
+    ``0.0``; the points are distinct), or -1: one hash per point, searched among the queries'."""
+    found = np.full(queries.shape[0], -1, dtype=np.int64)
+    point_bits = np.ascontiguousarray(points + 0.0).view(np.int64)
+    query_bits = np.ascontiguousarray(queries + 0.0).view(np.int64)
+    wanted = np.unique(cell_hash(query_bits))
+    keys = cell_hash(point_bits)
+    at = np.minimum(np.searchsorted(wanted, keys), wanted.shape[0] - 1)
+    candidates = np.flatnonzero(wanted[at] == keys)
+    if not candidates.size:
+        return found
+    index_of = {point_bits[i].tobytes(): i for i in candidates.tolist()}
+    for k, row in enumerate(query_bits):
+        found[k] = index_of.get(row.tobytes(), -1)
+    return found
+
+
+def _corner_hints(
+    merged: NDArray[np.float64], wanted: NDArray[np.float64], tolerance: float
+) -> BoolArray:
+    """Rule-4 corners: the joined vertex nearest to each of ``wanted`` within ``tolerance``.
+
+    A wanted point that is one of the vertices (the usual BSTONE) is its own nearest: the
+    joined vertices lie more than ``tolerance`` apart, so no other is as near (nor ties with
+    it once centred, when the tolerance exceeds the rounding of the centring). The others are
+    searched for (:func:`_nearest`)."""
+    hints = np.zeros(merged.shape[0], dtype=np.bool_)
+    centre = 0.5 * np.add(*column_extremes(merged))
+    extent = float(np.abs(merged - centre).max()) + float(np.abs(centre).max())
+    if tolerance > 16.0 * np.finfo(np.float64).eps * extent:
+        exact = _exact_rows(merged, wanted)
+        hints[exact[exact >= 0]] = True
+        wanted = wanted[exact < 0]
+    if wanted.shape[0]:
+        hints[_nearest(merged - centre, wanted - centre, max(tolerance, 0.0) * 1.0000001)] = True
+    return hints
 
 
 def corners_and_arcs(
@@ -591,7 +709,7 @@ def corners_and_arcs(
     vertices, triangles, owners = _patch_triangles(surfaces, patches)
     if triangles.shape[0] == 0:
         return [], [], {}
-    used, compact = np.unique(triangles, return_inverse=True)
+    used, compact = mesh.compact_indices(triangles, vertices.shape[0])
     points = vertices[used]
     if tolerance is None:
         low, high = column_extremes(points)
@@ -615,28 +733,31 @@ def corners_and_arcs(
     if extra_corners is not None:
         wanted = np.asarray(extra_corners, dtype=np.float64).reshape(-1, 3)
         if wanted.shape[0]:
-            centre = 0.5 * np.add(*column_extremes(merged))
-            hints = np.zeros(n_vertices, dtype=np.bool_)
-            hints[_nearest(merged - centre, wanted - centre, max(tolerance, 0.0) * 1.0000001)] = (
-                True
-            )
+            hints = _corner_hints(merged, wanted, tolerance)
     chains = chain_arc_edges(
         edges, offsets, incident_patch, np.flatnonzero(~inner), n_vertices, merged, hints
     )
 
-    corners = [Corner(id=i, point=merged[v]) for i, v in enumerate(chains.corners.tolist())]
+    # Corners and arcs are built from checked data (finite joined vertices, arcs of at least
+    # one edge between numbered corners): what their validation would do is done here.
+    corners = [
+        Corner.model_construct(id=i, point=as_readonly(merged[v]))
+        for i, v in enumerate(chains.corners.tolist())
+    ]
     arcs: list[Arc] = []
     patch_arcs: dict[int, list[int]] = {}
-    for a in range(chains.n_arcs):
-        members = _around(chains, a, merged, tri, offsets, incident, sides, incident_patch)
-        patch_ids = tuple(int(patches[int(m)].id) for m in members.tolist())
-        chain = chains.chain_vertices[chains.chain_offsets[a] : chains.chain_offsets[a + 1]]
+    orders = _patch_orders(chains, merged, tri, offsets, incident, sides, incident_patch)
+    patch_id_of = [int(p.id) for p in patches]
+    starts, ends = chains.arc_start.tolist(), chains.arc_end.tolist()
+    bounds = chains.chain_offsets.tolist()
+    for a, members in enumerate(orders):
+        patch_ids = tuple(patch_id_of[m] for m in members.tolist())
         arcs.append(
-            Arc(
+            Arc.model_construct(
                 id=a,
-                points=merged[chain],
-                start=int(chains.arc_start[a]),
-                end=int(chains.arc_end[a]),
+                points=as_readonly(merged[chains.chain_vertices[bounds[a] : bounds[a + 1]]]),
+                start=starts[a],
+                end=ends[a],
                 patches=patch_ids,
             )
         )

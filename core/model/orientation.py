@@ -33,7 +33,13 @@ from geobrep.errors import TopologyError
 from geobrep.geometry import mesh
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.geometry.orientation import orientation_flips
-from geobrep.model._shells import Shell, block_shells
+from geobrep.model._shells import (
+    Shell,
+    block_shell,
+    open_edges_if_one_way,
+    patch_edges,
+    patch_triangles,
+)
 from geobrep.model.entities import Block, PatchSide, Surface
 from geobrep.model.scene import Scene
 
@@ -195,10 +201,40 @@ def block_orientations(scene: Scene) -> list[BlockOrientation]:
     ]
     if not blocks:
         return []
-    return [
-        _shell_orientation(block, shell)
-        for block, shell in zip(blocks, block_shells(scene, blocks), strict=True)
-    ]
+    points, triangles_of = patch_triangles(scene, blocks)
+    edges = patch_edges(triangles_of, int(points.shape[0]))
+    areas = _patch_areas(points, triangles_of)
+    out = []
+    for block in blocks:
+        open_edges = None if edges is None else open_edges_if_one_way(edges, block)
+        shell = block_shell(points, triangles_of, block)
+        if open_edges is None:  # some triangles to turn: the whole rule
+            out.append(_shell_orientation(block, shell))
+            continue
+        out.append(_one_way_orientation(block, shell, areas, open_edges))
+    return out
+
+
+def _patch_areas(points: FloatArray, triangles_of: dict[int, IntArray]) -> dict[int, FloatArray]:
+    """The area of every triangle of every patch (one pass over all of them)."""
+    ids = list(triangles_of)
+    if not ids:
+        return {}
+    counts = np.array([triangles_of[i].shape[0] for i in ids], dtype=np.int64)
+    areas = mesh.face_areas(points, np.concatenate([triangles_of[i] for i in ids]))
+    return dict(zip(ids, np.split(areas, np.cumsum(counts)[:-1]), strict=True))
+
+
+def _one_way_orientation(
+    block: Block, shell: Shell, areas: dict[int, FloatArray], open_edges: int
+) -> BlockOrientation:
+    """:func:`_shell_orientation` of a shell known to run one way (no triangle turns)."""
+    internal = block.internal_patches
+    boundary = [s.patch for s in block.sides if s.patch not in internal]
+    area = float(np.concatenate([areas[p] for p in boundary]).sum())
+    centre = shell.vertices.mean(axis=0) if shell.vertices.size else np.zeros(3)
+    volume = mesh.signed_volume(shell.vertices - centre, shell.faces)
+    return _decide(block, np.zeros(len(boundary), dtype=np.bool_), volume, area, open_edges)
 
 
 def orient_blocks(scene: Scene) -> tuple[Scene, list[str]]:

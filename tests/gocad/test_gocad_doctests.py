@@ -9,6 +9,7 @@ import pytest
 
 MODULES = [
     "geobrep.model.arcs",
+    "geobrep.adapters.gocad._checks",
     "geobrep.adapters.gocad._headers",
     "geobrep.adapters.gocad._lexer",
     "geobrep.adapters.gocad._numbers",
