@@ -20,6 +20,11 @@ from numpy.typing import NDArray
 
 from geobrep.adapters._grid_cells import Grid, as_grid, cell_values, grid_entity, triple
 from geobrep.adapters.cell_layout import chain_segments
+from geobrep.adapters.geoh5._concatenated import (
+    concatenated_bytes,
+    is_concatenator,
+    read_concatenated,
+)
 from geobrep.adapters.geoh5._drillhole import read_drillhole, write_drillhole
 from geobrep.adapters.geoh5._schema import (
     ENTITY_FLAGS,
@@ -276,6 +281,16 @@ def read_geoh5(path: Path) -> Scene:
                     skipped.append(f"geoh5 object {label!r}: no reader for its type")
                 else:
                     entities.append(entity)
+            for ident, group in root.get("Groups", {}).items():
+                if not is_concatenator(group):
+                    continue
+                declared += concatenated_bytes(group)
+                check_declared(declared, budget, "its drillhole groups' datasets", path)
+                try:
+                    entities.extend(read_concatenated(group, root, len(entities), skipped))
+                except GeobrepError as exc:
+                    label = text(group.attrs.get("Name", ident))
+                    raise FormatError(f"drillhole group {label!r}: {exc}", path) from exc
             name = text(root["Root"].attrs.get("Name", path.stem)) if "Root" in root else path.stem
     except GeobrepError:
         raise
