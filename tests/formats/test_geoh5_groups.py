@@ -272,3 +272,19 @@ def test_declared_sizes_count_before_reading(tmp_path: Path, monkeypatch: Any) -
     monkeypatch.setattr(limits, "read_budget", lambda size: 1_000)
     with pytest.raises(FormatError, match="drillhole groups' datasets declares"):
         geobrep.read(FILE)
+
+
+@pytest.mark.parametrize(("fmt", "suffix"), [("las", ".las"), ("deviation", ".dev")])
+def test_the_wells_to_a_format_of_one_well(
+    scene: geobrep.Scene, tmp_path: Path, fmt: str, suffix: str
+) -> None:
+    """Three wells to a one-well format: the first is written, the others reported, and the
+    report does not claim they were merged."""
+    target = tmp_path / f"first{suffix}"
+    lost = format_losses(scene, registries().formats.get(fmt), target)
+    assert not [m for m in lost if "merged" in m]
+    assert "Well 'DH-2': only the first well is written" in lost
+    geobrep.write(scene, target)
+    back = geobrep.read(target)
+    assert len(back.entities) == 1
+    np.testing.assert_allclose(back.entities[0].md, scene["DH-1"].md)
