@@ -37,7 +37,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep.adapters.geoh5._desurvey import desurvey
-from geobrep.adapters.geoh5._schema import FLOAT_NDV, INTEGER_NDV, OBJECT_TYPES, text, xyz
+from geobrep.adapters.geoh5._schema import (
+    FLOAT_NDV,
+    INTEGER_NDV,
+    OBJECT_TYPES,
+    text,
+    whole,
+    xyz,
+)
 from geobrep.errors import FormatError
 from geobrep.model.entities import Well, WellLog, WellMarker, WellZone
 
@@ -124,7 +131,7 @@ class _Arrays:
             source = data[label] if data is not None and label in data else self.concat.get(label)
             if not isinstance(source, h5py.Dataset):
                 raise FormatError(f"concatenated array {label!r} is indexed but missing")
-            self.read[label] = source[()]
+            self.read[label] = whole(source)
         array = self.read[label]
         if start < 0 or size < 0 or start + size > array.shape[0]:
             raise FormatError(

@@ -35,6 +35,7 @@ from geobrep.adapters.geoh5._schema import (
     text,
     uid,
     vertex_rows,
+    whole,
     xyz,
 )
 from geobrep.adapters.limits import check_declared
@@ -188,7 +189,7 @@ def _read_data(obj: h5py.Group, association: str, n: int, order: Any = None) -> 
     for data in obj.get("Data", {}).values():
         if text(data.attrs.get("Association", "")) != association or "Data" not in data:
             continue
-        values = np.asarray(data["Data"][()])
+        values = whole(data["Data"])
         if values.ndim != 1 or values.dtype.kind not in "biuf" or len(values) != n:
             continue
         kind = data.get("Type")
@@ -238,11 +239,11 @@ def _object(obj: h5py.Group, ident: int, skipped: list[str]) -> Entity | None:
         return read_drillhole(obj, name, ident, skipped)
     if kind is None or "Vertices" not in obj:
         return None
-    vertices = xyz(obj["Vertices"][()])
+    vertices = xyz(whole(obj["Vertices"]))
     points = _read_data(obj, "Vertex", len(vertices))
     if kind == "Points":
         return PointSet(vertices=vertices, name=name, point_data=points, id=ident)
-    cells = _cells(obj["Cells"][()]) if "Cells" in obj else np.zeros((0, 3), np.int64)
+    cells = _cells(whole(obj["Cells"])) if "Cells" in obj else np.zeros((0, 3), np.int64)
     cell_data = _read_data(obj, "Cell", len(cells))
     if kind == "Surface":
         return Surface(
