@@ -115,14 +115,14 @@ def _resqpy_direct(
         collection.create_xml_for_imported_list_and_add_parts_to_model()
         model.store_epc()
 
-    def read() -> None:
+    def read() -> list[Any]:
         model = rq.Model(str(path))
         rep = rqs.Surface(model, uuid=model.uuid(obj_type="TriangulatedSetRepresentation"))
         triangles, points = rep.triangles_and_points()
-        np.asarray(triangles, dtype=np.int64), np.asarray(points, dtype=np.float64)
+        kept = [np.asarray(triangles, dtype=np.int64), np.asarray(points, dtype=np.float64)]
         collection = rqp.PropertyCollection(support=rep)
-        for part in collection.parts():
-            collection.cached_part_array_ref(part)
+        kept.extend(collection.cached_part_array_ref(part) for part in collection.parts())
+        return kept  # held to the end, as a Surface holds them
 
     return write, read
 
@@ -166,7 +166,8 @@ def _h5py_direct(
     """The geoh5 objects geobrep writes, by h5py: the workspace's groups and types, the
     Surface object (x, y, z records, int32 cells) and its vertex data with their attributes;
     read back as a Surface holds them (float64 points, the int32 triangles as stored, the
-    data)."""
+    data), every array held to the end of the read as the Surface holds them (an array freed
+    at once lets the next reuse its memory, which a reader building entities cannot)."""
     import h5py
 
     path = folder / "direct.geoh5"
@@ -202,14 +203,15 @@ def _h5py_direct(
             data["Type"] = data_type
             obj.create_group("Data")["{d}"] = data
 
-    def read() -> None:
+    def read() -> list[Any]:
+        kept = []  # held to the end, as a Surface holds them (not freed one by one)
         with h5py.File(path, "r") as store:
             for obj in store["GEOSCIENCE/Objects"].values():
                 rows = obj["Vertices"][()]
-                np.column_stack([rows["x"], rows["y"], rows["z"]])
-                obj["Cells"][()]
-                for data in obj["Data"].values():
-                    data["Data"][()]
+                kept.append(np.column_stack([rows["x"], rows["y"], rows["z"]]))
+                kept.append(obj["Cells"][()])
+                kept.extend(data["Data"][()] for data in obj["Data"].values())
+        return kept
 
     return write, read
 
@@ -227,13 +229,14 @@ def _h5py_read_direct(folder: Path) -> Callable[[], Any]:
         dataset.read_direct(array)
         return array
 
-    def read() -> None:
+    def read() -> list[Any]:
+        kept = []
         with h5py.File(path, "r") as store:
             for obj in store["GEOSCIENCE/Objects"].values():
-                whole(obj["Vertices"]).view("<f8").reshape(-1, 3)
-                whole(obj["Cells"])
-                for data in obj["Data"].values():
-                    whole(data["Data"])
+                kept.append(whole(obj["Vertices"]).view("<f8").reshape(-1, 3))
+                kept.append(whole(obj["Cells"]))
+                kept.extend(whole(data["Data"]) for data in obj["Data"].values())
+        return kept
 
     return read
 
