@@ -187,6 +187,32 @@ class TestArrayFields:
         points = PointSet(vertices=vertices)
         assert points.vertices.tobytes() == vertices.tobytes()
 
+    def test_finite_points_whose_sum_overflows_are_kept(self) -> None:
+        """The one-pass finiteness check sums the values: an overflowing sum of finite values
+        is checked value by value, not refused; infinities of both signs are refused."""
+        huge = np.full((4, 3), 1e308)
+        assert PointSet(vertices=huge).vertices.tobytes() == huge.tobytes()
+        assert PointSet(vertices=-huge).n_points == 4
+        both = np.ones((3, 3))
+        both[0, 0], both[2, 2] = np.inf, -np.inf  # the sum is NaN
+        invalid(
+            lambda: PointSet(vertices=both, name="p"), "PointSet 'p'", "vertices", "2 non-finite"
+        )
+
+    @given(
+        hnp.arrays(
+            np.float64,
+            st.tuples(st.integers(1, 20), st.just(3)),
+            elements=st.floats(allow_nan=True, allow_infinity=True),
+        )
+    )
+    def test_non_finite_anywhere_is_refused(self, vertices: np.ndarray) -> None:
+        if np.isfinite(vertices).all():
+            assert PointSet(vertices=vertices).vertices.tobytes() == vertices.tobytes()
+        else:
+            with pytest.raises(EntityValidationError, match="non-finite"):
+                PointSet(vertices=vertices)
+
     @given(
         hnp.arrays(
             np.float64,

@@ -8,6 +8,13 @@
    model with data) and ``geoh5py-expected.npz`` (what geoh5py says the file holds).
 3. ``read DIR`` (geobrep's venv): geobrep reads ``geoh5py.geoh5`` and must find those arrays.
 
+Step 2 also writes ``drillhole-group.geoh5``: a ``DrillholeGroup`` whose drillholes geoh5py
+files concatenated (geoh5 2.1), with surveys, depth logs (float, integer, a gap), referenced
+depth data, referenced and numeric interval tables, and ``drillhole-group-expected.npz``:
+geoh5py's collars, surveys, desurveyed stations, logs, markers and zones; step 3 reads it with
+geobrep and compares them array by array. ``group FILE`` (geoh5py venv) writes just that file
+and its ``.npz`` beside it: tests/data/geoh5/ holds one made so (tests/data/geoh5/SOURCES.md).
+
 Each step prints what it compared and exits 1 on the first difference.
 """
 
@@ -218,6 +225,182 @@ def _geoh5py_drillhole(workspace: Any) -> dict[str, Any]:
     }
 
 
+def _group_holes() -> list[dict[str, Any]]:
+    """Three drillholes: deviated with a log gap, an integer log and picks; one survey row."""
+    depth = np.arange(1.0, 420.0, 2.5)
+    gr = 60 + 50 * np.sin(depth / 20)
+    gr[40:46] = np.nan  # not logged there: geoh5's no-data value
+    picks = np.zeros(depth.shape, dtype=np.int32)
+    picks[[12, 70, 131]] = [1, 2, 1]
+    return [
+        {
+            "name": "DH-1",
+            "collar": [450500.0, 6700600.0, 95.0],
+            "surveys": [[0.0, 45.0, -90.0], [150.0, 50.0, -80.0], [400.0, 70.0, -60.0]],
+            "data": {
+                "gr": {"values": gr, "depth": depth},
+                "litho": {
+                    "type": "referenced",
+                    "values": np.array([1, 2, 1], dtype=np.int32),
+                    "value_map": {1: "sand", 2: "shale"},
+                    "from-to": np.array([[10.0, 120.0], [120.0, 300.5], [300.5, 440.0]]),
+                },
+                "au": {
+                    "values": np.array([0.25, 1.5, 0.125]),
+                    "from-to": np.array([[12.0, 14.0], [14.0, 16.5], [30.0, 31.0]]),
+                },
+            },
+        },
+        {
+            "name": "DH-2",
+            "collar": [450620.0, 6700580.0, 101.5],
+            "surveys": [[0.0, 120.0, -75.0], [90.0, 125.0, -70.0], [210.0, 140.0, -62.5]],
+            "data": {
+                "facies": {
+                    "values": (np.arange(depth.size) % 4).astype(np.int32),
+                    "depth": depth,
+                },
+                "picks": {
+                    "type": "referenced",
+                    "values": picks,
+                    "value_map": {1: "H1 top", 2: "F1"},
+                    "depth": depth,
+                },
+            },
+        },
+        {
+            "name": "DH-3",
+            "collar": [450480.0, 6700720.0, 90.0],
+            "surveys": [[0.0, 0.0, -90.0]],
+            "data": {
+                "unit": {
+                    "type": "referenced",
+                    "values": np.array([3, 1], dtype=np.int32),
+                    "value_map": {1: "U1", 3: "U3"},
+                    "from-to": np.array([[0.0, 55.0], [55.0, 80.25]]),
+                },
+            },
+        },
+    ]
+
+
+def write_drillhole_group(target: Path) -> dict[str, Any]:
+    """Write the drillhole group with geoh5py; what geoh5py then says each drillhole holds."""
+    from geoh5py.groups import DrillholeGroup
+    from geoh5py.objects import Drillhole
+    from geoh5py.workspace import Workspace
+
+    target.unlink(missing_ok=True)
+    with Workspace.create(target) as workspace:
+        group = DrillholeGroup.create(workspace, name="holes")
+        for spec in _group_holes():
+            hole = Drillhole.create(
+                workspace,
+                name=spec["name"],
+                collar=np.array(spec["collar"]),
+                surveys=np.array(spec["surveys"]),
+                parent=group,
+            )
+            hole.add_data(spec["data"])
+    found: dict[str, Any] = {}
+    with Workspace(target, mode="r") as workspace:
+        holes = [o for o in workspace.objects if type(o).__name__ == "ConcatenatedDrillhole"]
+        for hole in sorted(holes, key=lambda h: h.name):
+            found.update(_hole_expected(hole))
+    return found
+
+
+def _hole_expected(hole: Any) -> dict[str, Any]:
+    """geoh5py's view of a concatenated drillhole, keyed ``name|...``: collar, surveys, the
+    stations geobrep places (depth 0, survey depths, end of hole, deepest sample: geoh5py's
+    desurveying there), logs without their no-data rows, markers and zones."""
+    key = hole.name
+    found: dict[str, Any] = {
+        f"{key}|collar": np.array([hole.collar["x"], hole.collar["y"], hole.collar["z"]]),
+        f"{key}|surveys": np.asarray(hole.surveys, dtype=np.float64),
+    }
+    markers, zones, deepest = [], [], 0.0
+    for group in hole.property_groups or []:
+        members = [hole.get_data(u)[0] for u in group.properties]
+        if group.property_group_type == "Depth table":
+            depth = np.asarray(members[0].values, dtype=np.float64)
+            for member in members[1:]:
+                values = np.asarray(member.values)
+                kept = ~np.isnan(values) if values.dtype.kind == "f" else values != member.ndv
+                if type(member).__name__.endswith("ReferencedData"):
+                    names = member.value_map()
+                    markers += [
+                        f"{names[int(values[r])]}@{float(depth[r])}"
+                        for r in np.flatnonzero(kept & (values > 0))
+                    ]
+                else:
+                    found[f"{key}|log|{member.name}|md"] = depth[kept]
+                    found[f"{key}|log|{member.name}|values"] = values[kept]
+                deepest = max(deepest, float(depth[kept].max(initial=0.0)))
+        else:
+            tops = np.asarray(members[0].values, dtype=np.float64)
+            bases = np.asarray(members[1].values, dtype=np.float64)
+            deepest = max(deepest, float(bases.max(initial=0.0)))
+            for member in members[2:]:
+                values = np.asarray(member.values)
+                if type(member).__name__.endswith("ReferencedData"):
+                    names = member.value_map()
+                    zones += [
+                        f"{names[int(v)]}@{t}@{b}@{member.name}"
+                        for v, t, b in zip(values, tops, bases, strict=True)
+                        if v > 0
+                    ]
+                else:
+                    zones += [
+                        f"{member.name}@{t}@{b}@{v.item()!r}"
+                        for v, t, b in zip(values, tops, bases, strict=True)
+                    ]
+    surveys = found[f"{key}|surveys"]
+    end = hole.end_of_hole
+    stops = [[0.0], surveys[:, 0], [] if end is None else [end]]
+    if deepest > max(float(surveys[-1, 0]), end or 0.0):
+        stops.append([deepest])
+    md = np.unique(np.concatenate(stops))
+    found[f"{key}|md"] = md
+    found[f"{key}|stations"] = hole.desurvey(md)
+    found[f"{key}|markers"] = np.array(sorted(markers, key=lambda m: float(m.split("@")[1])))
+    found[f"{key}|zones"] = np.array(zones)
+    return found
+
+
+def group_step(target: Path) -> None:
+    found = write_drillhole_group(target)
+    np.savez(target.with_suffix(".npz"), **found)
+    print(f"geoh5py wrote {target} and what it holds, {target.with_suffix('.npz')}")
+
+
+def check_drillhole_group(scene: Any, expected: Any, metres: float = 1e-9) -> int:
+    """Compare geobrep's Wells of the drillhole group with geoh5py's view; arrays compared."""
+    names = sorted({k.split("|")[0] for k in expected.files})
+    compared = 0
+    for name in names:
+        well = scene[name]
+        _same(f"{name} collar", well.head, expected[f"{name}|collar"])
+        _same(f"{name} md", well.md, expected[f"{name}|md"])
+        _close(f"{name} stations", well.vertices, expected[f"{name}|stations"], metres)
+        compared += 3
+        for log in [k.split("|")[2] for k in expected.files if k.startswith(f"{name}|log|")]:
+            _same(f"{name} {log} depths", well.logs[log].md, expected[f"{name}|log|{log}|md"])
+            want = expected[f"{name}|log|{log}|values"]
+            _same(f"{name} {log} values", well.logs[log].values, want)
+            compared += 1
+        markers = [f"{m.name}@{m.md}" for m in well.markers]
+        _same(f"{name} markers", np.array(markers), expected[f"{name}|markers"])
+        zones = [
+            f"{z.name}@{z.top_md}@{z.base_md}@"
+            + (repr(z.metadata["value"]) if "value" in z.metadata else z.metadata["geoh5 data"])
+            for z in well.zones
+        ]
+        _same(f"{name} zones", np.array(zones), expected[f"{name}|zones"])
+        compared += 2
+    return compared
+
+
 def geoh5py_step(folder: Path) -> None:
     from geoh5py.objects import BlockModel, Curve, Drillhole, Points, Surface
     from geoh5py.workspace import Workspace
@@ -286,6 +469,7 @@ def geoh5py_step(folder: Path) -> None:
         found.update(_geoh5py_drillhole(workspace))
     np.savez(folder / "geoh5py-expected.npz", **found)
     print(f"geoh5py wrote {target}")
+    group_step(folder / "drillhole-group.geoh5")
 
 
 def read_step(folder: Path) -> None:
@@ -314,9 +498,17 @@ def read_step(folder: Path) -> None:
     zones = [f"{z.name}@{z.top_md}@{z.base_md}" for z in dh.zones]
     _same("dh zones", np.array(zones), expected["dh|zones"])
     print("geobrep read what geoh5py wrote: 5 objects, all arrays equal")
+    group = np.load(folder / "drillhole-group.npz")
+    wells = geobrep.read(folder / "drillhole-group.geoh5")
+    compared = check_drillhole_group(wells, group)
+    print(f"geobrep read geoh5py's drillhole group: {len(wells.entities)} wells, {compared} equal")
 
 
 if __name__ == "__main__":
     step, where = sys.argv[1], Path(sys.argv[2])
-    where.mkdir(parents=True, exist_ok=True)
-    {"write": write_step, "geoh5py": geoh5py_step, "read": read_step}[step](where)
+    if step == "group":
+        where.parent.mkdir(parents=True, exist_ok=True)
+        group_step(where)
+    else:
+        where.mkdir(parents=True, exist_ok=True)
+        {"write": write_step, "geoh5py": geoh5py_step, "read": read_step}[step](where)

@@ -23,6 +23,7 @@ __all__ = [
     "uid",
     "value_map",
     "vertex_rows",
+    "whole",
     "xyz",
 ]
 
@@ -62,6 +63,21 @@ def xyz(rows: NDArray[Any]) -> NDArray[np.float64]:
     if rows.dtype.names:
         return np.column_stack([rows[k] for k in ("x", "y", "z")]).astype(np.float64)
     return np.asarray(rows, dtype=np.float64).reshape(-1, 3)
+
+
+def whole(dataset: Any) -> NDArray[Any]:
+    """All of a dataset as a new array, read straight into it (``read_direct``: h5py's
+    ``dataset[()]`` fills a zeroed array through more steps); strings and scalars as h5py
+    gives them."""
+    if not isinstance(dataset, h5py.Dataset):
+        raise TypeError(f"{dataset!r} is not a dataset")
+    shape, dtype = dataset.shape, dataset.dtype
+    if not shape or dtype.hasobject or dtype.kind not in "biufV":
+        return np.asarray(dataset[()])
+    array = np.empty(shape, dtype=dtype)
+    if array.size:
+        dataset.read_direct(array)
+    return array
 
 
 def object_type(root: h5py.Group, name: str) -> h5py.Group:
@@ -115,7 +131,7 @@ def data_values(data: h5py.Group) -> tuple[str, str, NDArray[Any]] | None:
         return None
     kind = data.get("Type")
     primitive = "" if kind is None else text(kind.attrs.get("Primitive type", ""))
-    return text(data.attrs.get("Name", "")), primitive, np.asarray(data["Data"][()])
+    return text(data.attrs.get("Name", "")), primitive, whole(data["Data"])
 
 
 def value_map(data: h5py.Group) -> dict[int, str]:

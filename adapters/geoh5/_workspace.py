@@ -20,6 +20,11 @@ from numpy.typing import NDArray
 
 from geobrep.adapters._grid_cells import Grid, as_grid, cell_values, grid_entity, triple
 from geobrep.adapters.cell_layout import chain_segments
+from geobrep.adapters.geoh5._concatenated import (
+    concatenated_bytes,
+    is_concatenator,
+    read_concatenated,
+)
 from geobrep.adapters.geoh5._drillhole import read_drillhole, write_drillhole
 from geobrep.adapters.geoh5._schema import (
     ENTITY_FLAGS,
@@ -30,6 +35,7 @@ from geobrep.adapters.geoh5._schema import (
     text,
     uid,
     vertex_rows,
+    whole,
     xyz,
 )
 from geobrep.adapters.limits import check_declared
@@ -183,7 +189,7 @@ def _read_data(obj: h5py.Group, association: str, n: int, order: Any = None) -> 
     for data in obj.get("Data", {}).values():
         if text(data.attrs.get("Association", "")) != association or "Data" not in data:
             continue
-        values = np.asarray(data["Data"][()])
+        values = whole(data["Data"])
         if values.ndim != 1 or values.dtype.kind not in "biuf" or len(values) != n:
             continue
         kind = data.get("Type")
@@ -233,11 +239,11 @@ def _object(obj: h5py.Group, ident: int, skipped: list[str]) -> Entity | None:
         return read_drillhole(obj, name, ident, skipped)
     if kind is None or "Vertices" not in obj:
         return None
-    vertices = xyz(obj["Vertices"][()])
+    vertices = xyz(whole(obj["Vertices"]))
     points = _read_data(obj, "Vertex", len(vertices))
     if kind == "Points":
         return PointSet(vertices=vertices, name=name, point_data=points, id=ident)
-    cells = _cells(obj["Cells"][()]) if "Cells" in obj else np.zeros((0, 3), np.int64)
+    cells = _cells(whole(obj["Cells"])) if "Cells" in obj else np.zeros((0, 3), np.int64)
     cell_data = _read_data(obj, "Cell", len(cells))
     if kind == "Surface":
         return Surface(
@@ -276,6 +282,16 @@ def read_geoh5(path: Path) -> Scene:
                     skipped.append(f"geoh5 object {label!r}: no reader for its type")
                 else:
                     entities.append(entity)
+            for ident, group in root.get("Groups", {}).items():
+                if not is_concatenator(group):
+                    continue
+                declared += concatenated_bytes(group)
+                check_declared(declared, budget, "its drillhole groups' datasets", path)
+                try:
+                    entities.extend(read_concatenated(group, root, len(entities), skipped))
+                except GeobrepError as exc:
+                    label = text(group.attrs.get("Name", ident))
+                    raise FormatError(f"drillhole group {label!r}: {exc}", path) from exc
             name = text(root["Root"].attrs.get("Name", path.stem)) if "Root" in root else path.stem
     except GeobrepError:
         raise

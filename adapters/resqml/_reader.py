@@ -49,8 +49,9 @@ _REPRESENTATIONS = (
 _QUIET = ("obj_EpcExternalPartReference", "obj_PropertyKind", "Feature", "Interpretation", "Crs")
 
 
-def _check_sizes(path: Path) -> Path:
-    """Refuse an EPC or HDF5 file declaring more than its read budget; the .h5 beside it."""
+def _check_sizes(path: Path) -> tuple[Path, h5py.File]:
+    """Refuse an EPC or HDF5 file declaring more than its read budget; the .h5 beside it, and
+    the HDF5 file open for reading (resqpy is given this handle: one open, not two)."""
     try:
         with zipfile.ZipFile(path) as archive:
             declared = sum(info.file_size for info in archive.infolist())
@@ -62,35 +63,50 @@ def _check_sizes(path: Path) -> Path:
         raise FormatError(f"the HDF5 file beside it ({h5.name}) is missing", path)
     total = 0
     try:
-        with h5py.File(h5, "r") as store:
-
-            def add(name: str, item: Any) -> None:
-                nonlocal total
-                if isinstance(item, h5py.Dataset):
-                    total += int(item.size) * item.dtype.itemsize
-
-            store.visititems(add)
+        store = h5py.File(h5, "r")
     except OSError as exc:
         raise FormatError(f"the HDF5 file beside it cannot be read: {exc}", h5) from exc
-    check_declared(total, h5.stat().st_size, "its datasets", h5)
-    return h5
+    try:
+
+        def add(name: str, item: Any) -> None:
+            nonlocal total
+            if isinstance(item, h5py.Dataset):
+                total += int(item.size) * item.dtype.itemsize
+
+        store.visititems(add)
+        check_declared(total, h5.stat().st_size, "its datasets", h5)
+    except BaseException as exc:
+        store.close()
+        if isinstance(exc, OSError):
+            raise FormatError(f"the HDF5 file beside it cannot be read: {exc}", h5) from exc
+        raise
+    return h5, store
 
 
 def read_resqml(path: Path) -> Scene:
     """The scene of the RESQML model ``path``."""
     import resqpy.model as rq
 
-    _check_sizes(path)
+    h5, store = _check_sizes(path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
+        model = None
         try:
             model = rq.Model(str(path))
             model.h5_set_default_override("full")  # the .h5 of the same stem, as checked
+            # resqpy reuses the handle it finds open on the same file (``Model.h5_access``)
+            model.h5_currently_open_path = str(h5)
+            model.h5_currently_open_mode = "r"
+            model.h5_currently_open_root = store
             return _scene(model, path)
         except GeobrepError:
             raise
         except Exception as exc:  # resqpy asserts, indexes and parses without checking first
             raise FormatError(f"damaged RESQML model ({type(exc).__name__}: {exc})", path) from exc
+        finally:
+            if model is not None and model.h5_currently_open_root is not None:
+                model.h5_release()
+            store.close()
 
 
 def _scene(model: Any, path: Path) -> Scene:
@@ -188,10 +204,66 @@ def _entity(model: Any, obj_type: str, uuid: Any) -> Entity:
     return _finish(model, rep, PolyLine, line, len(vertices), int(counts.sum() - (~closed).sum()))
 
 
+def _read_whole(model: Any, node: Any, tag: str, dtype: Any, columns: int | None) -> Any:
+    """The HDF5 array of ``node`` read straight into a new ``dtype`` array (HDF5 converts while
+    reading: no zero-filled array, copy or cast as resqpy's cache makes), or None when its
+    shape is not ``(n,)`` / ``(n, columns)`` (resqpy's own reading then has its say)."""
+    key = model.h5_uuid_and_path_for_node(node, tag=tag)
+    if key is None:
+        return None
+    dataset = model.h5_access(key[0]).get(key[1])
+    if not isinstance(dataset, h5py.Dataset) or dataset.dtype.kind not in "iuf":
+        return None
+    shape = dataset.shape
+    if (columns is None and len(shape) != 1) or (
+        columns is not None and (len(shape) != 2 or shape[1] != columns)
+    ):
+        return None
+    array = np.empty(shape, dtype=dtype)
+    if array.size:
+        dataset.read_direct(array)
+    return array
+
+
+def _patch_arrays(model: Any, rep: Any) -> tuple[Any, Any] | None:
+    """Triangles (int64) and points (float64) of every patch of ``rep``, read straight from the
+    HDF5 file, patches one after the other (each patch's triangles offset by the points before
+    it, as resqpy's ``triangles_and_points``); None for any other layout."""
+    import resqpy.olio.xml_et as rqet
+
+    rep.extract_patches(rep.root)
+    parts = []
+    for patch in rep.patch_list:
+        geometry = rqet.find_tag(patch.node, "Geometry")
+        points = None if geometry is None else rqet.find_tag(geometry, "Points")
+        triangles = rqet.find_tag(patch.node, "Triangles")
+        if points is None or triangles is None or rqet.node_type(points) != "Point3dHdf5Array":
+            return None
+        xyz = _read_whole(model, points, "Coordinates", np.float64, 3)
+        corners = _read_whole(model, triangles, "Values", np.int64, 3)
+        if xyz is None or corners is None:
+            return None
+        parts.append((corners, xyz))
+    if len(parts) == 1:
+        return parts[0]
+    if not parts:
+        return None
+    offsets = np.cumsum([0] + [len(p) for _, p in parts[:-1]])
+    return (
+        np.concatenate([t + o for (t, _), o in zip(parts, offsets, strict=True)]),
+        np.concatenate([p for _, p in parts]),
+    )
+
+
 def _surface(model: Any, rep: Any) -> Entity:
-    triangles, points = rep.triangles_and_points()
+    direct = _patch_arrays(model, rep)
+    if direct is None:
+        triangles, points = rep.triangles_and_points()
+        triangles = np.asarray(triangles, dtype=np.int64)
+    else:
+        triangles, points = direct
     vertices = _world(model, rep.crs_uuid, points)
-    fields: dict[str, Any] = {"vertices": vertices, "faces": np.asarray(triangles, dtype=np.int64)}
+    fields: dict[str, Any] = {"vertices": vertices, "faces": triangles}
     if rep.number_of_patches() > 1:
         fields["patch_labels"] = np.asarray(
             rep.patch_indices_for_triangle_indices(np.arange(len(triangles)))
@@ -209,7 +281,7 @@ def _properties(rep: Any, n_nodes: int, n_cells: int) -> tuple[dict[str, Any], d
     for part in collection.parts():
         name = collection.citation_title_for_part(part)
         element = collection.indexable_for_part(part)
-        values = np.asarray(collection.cached_part_array_ref(part, masked=False))
+        values = _property_values(collection, part)
         unit = None if not collection.continuous_for_part(part) else collection.uom_for_part(part)
         unit = None if unit in (None, "Euc") else unit
         if element == "nodes" and len(values) == n_nodes:
@@ -217,6 +289,30 @@ def _properties(rep: Any, n_nodes: int, n_cells: int) -> tuple[dict[str, Any], d
         elif element in ("faces", "intervals") and len(values) == n_cells:
             cells[name] = (values, unit)
     return nodes, cells
+
+
+def _property_values(collection: Any, part: Any) -> NDArray[Any]:
+    """The values of a property part as resqpy gives them (float64 for doubles, int64 for
+    integers), read straight from the HDF5 file when it is one patch of values; other parts
+    (constant, packed, points) through resqpy."""
+    import resqpy.olio.xml_et as rqet
+
+    node = collection.node_for_part(part)
+    patches = [] if node is None else rqet.list_of_tag(node, "PatchOfValues")
+    if (
+        len(patches) == 1
+        and collection.constant_value_for_part(part) is None
+        and not collection.points_for_part(part)
+    ):
+        values = rqet.find_tag(patches[0], "Values")
+        dtype = {"DoubleHdf5Array": np.float64, "IntegerHdf5Array": np.int64}.get(
+            "" if values is None else rqet.node_type(values)
+        )
+        if dtype is not None:
+            array = _read_whole(collection.model, values, "Values", dtype, None)
+            if array is not None:
+                return array  # type: ignore[no-any-return]
+    return np.asarray(collection.cached_part_array_ref(part, masked=False))
 
 
 def _finish(

@@ -80,7 +80,8 @@ def capability_losses(scene: Scene, caps: FormatCapabilities) -> list[str]:
         lost.append(f"topology dropped ({len(scene.patches)} patches)")
     if scene.crs is not None and not caps.crs:
         lost.append(f"CRS {scene.crs.label} dropped")
-    if len(kept) > 1 and not caps.multiple_entities:
+    if len(kept) > 1 and not caps.multiple_entities and not all(e.type == "Well" for e in kept):
+        # (wells are never merged: a format of one well writes the first and says so)
         lost.append(f"{len(kept)} entities merged into one")
     named = [e for e in kept if e.name]
     if named and not caps.names:

@@ -160,6 +160,15 @@ def _check_shape(array: NDArray[Any], shape: tuple[int | None, ...] | None) -> N
     return array
 
 
+def _all_finite(array: NDArray[Any]) -> bool:
+    """Every value finite, in one pass and no temporary array: a sum is finite when every term
+    is (NaN and infinities carry through a sum); only a sum that is not (those, or finite
+    terms overflowing) is looked at value by value."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = np.add.reduce(array, axis=None)
+    return bool(np.isfinite(total)) or bool(np.isfinite(array).all())
+
+
 def _first_nonfinite(array: NDArray[Any]) -> str:
     bad = ~np.isfinite(array)
     count = int(bad.sum())
@@ -193,7 +202,7 @@ def _make_validator(
         if columns is not None and array.ndim == 2 and array.shape[1] not in columns:
             allowed = " or ".join(str(t) for t in columns)
             raise ValueError(f"expected {allowed} columns, got shape {array.shape}")
-        if finite and array.dtype.kind == "f" and not np.isfinite(array).all():
+        if finite and array.dtype.kind == "f" and not _all_finite(array):
             raise ValueError(_first_nonfinite(array))
         return as_readonly(array)
 

@@ -111,6 +111,8 @@ def check(source: Scene, back: Scene, lost: tuple[str, ...], caps: FormatCapabil
             continue
         if not has_geometry(entity) and _said(lost, f"without geometry dropped: .*{entity.label}"):
             continue  # said dropped: must not come back (checked by the counts below)
+        if _said(lost, rf"^{re.escape(entity.label)}: only the first well is written$"):
+            continue  # a format of one well: the others are said not written
         kept.append(entity)
     types = Counter(e.type for e in source.entities)
     for type_name, count in types.items():

@@ -181,3 +181,91 @@ def test_declared_sizes_beyond_the_budget_are_refused(tmp_path: Path) -> None:
         archive.writestr("[Content_Types].xml", b"<" + b" " * (200 * 2**20))
     with pytest.raises(FormatError, match="declares"):
         read(path)
+
+
+def _two_patch_model(path: Path) -> None:
+    """Two patches (the second's triangles index its own points), a float node property and
+    an integer face property, written by resqpy."""
+    import resqpy.crs as rqc
+    import resqpy.property as rqp
+
+    model = rq.new_model(str(path))
+    crs = rqc.Crs(model, z_inc_down=False)
+    crs.create_xml()
+    rng = np.random.default_rng(5)
+    a, b = rng.uniform(0, 100, (6, 3)), rng.uniform(0, 100, (5, 3))
+    ta = np.array([[0, 1, 2], [2, 3, 4], [3, 4, 5]])
+    tb = np.array([[0, 1, 2], [1, 3, 4]])
+    surface = rqs.Surface(model, crs_uuid=crs.uuid, title="S")
+    surface.set_multi_patch_from_triangles_and_points([(ta, a), (tb, b)])
+    surface.write_hdf5()
+    surface.create_xml()
+    collection = rqp.PropertyCollection()
+    collection.set_support(support=surface)
+    collection.add_cached_array_to_imported_list(
+        rng.uniform(size=11), "test", "t", property_kind="continuous", indexable_element="nodes"
+    )
+    collection.add_cached_array_to_imported_list(
+        np.arange(5) * 3,
+        "test",
+        "n",
+        property_kind="discrete",
+        discrete=True,
+        indexable_element="faces",
+    )
+    collection.write_hdf5_for_imported_list()
+    collection.create_xml_for_imported_list_and_add_parts_to_model()
+    model.store_epc()
+
+
+def _resqpy_view(path: Path) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+    import resqpy.property as rqp
+
+    model = rq.Model(str(path))
+    rep = rqs.Surface(model, uuid=model.uuid(obj_type="TriangulatedSetRepresentation"))
+    triangles, points = rep.triangles_and_points()
+    collection = rqp.PropertyCollection(support=rep)
+    values = {
+        collection.citation_title_for_part(p): np.asarray(collection.cached_part_array_ref(p))
+        for p in collection.parts()
+    }
+    return np.asarray(triangles, dtype=np.int64), np.asarray(points, dtype=np.float64), values
+
+
+@pytest.mark.parametrize("through", ["hdf5", "resqpy"])
+@pytest.mark.parametrize("points_dtype", ["<f8", "<f4"])
+def test_arrays_read_straight_equal_resqpys(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, through: str, points_dtype: str
+) -> None:
+    """geobrep reads a surface's arrays straight from the HDF5 file (``through="hdf5"``) or,
+    for layouts it does not read so, through resqpy: the same arrays and dtypes either way,
+    several patches and float32 points included."""
+    import h5py
+
+    from geobrep.adapters.resqml import _reader
+
+    path = tmp_path / "two.epc"
+    _two_patch_model(path)
+    if points_dtype == "<f4":
+        with h5py.File(path.with_suffix(".h5"), "r+") as store:
+            names: list[str] = []
+            store.visit(names.append)
+            for name in [n for n in names if n.rsplit("/", 1)[-1].startswith("points_patch")]:
+                values = store[name][()].astype(np.float32)
+                del store[name]
+                store.create_dataset(name, data=values)
+    if through == "resqpy":
+        monkeypatch.setattr(_reader, "_read_whole", lambda *args: None)
+    triangles, points, values = _resqpy_view(path)
+    (surface,) = read(path).surfaces
+    assert surface.faces.dtype == np.int64
+    assert surface.vertices.dtype == np.float64
+    assert np.array_equal(surface.faces, triangles)
+    assert surface.vertices.tobytes() == points.tobytes()
+    assert surface.patch_labels is not None
+    assert surface.patch_labels.tolist() == [0, 0, 0, 1, 1]
+    for name, want in values.items():
+        data = surface.point_data if want.shape[0] == 11 else surface.cell_data
+        got = data[name].values
+        assert got.dtype == want.dtype, name
+        assert got.tobytes() == want.tobytes(), name
