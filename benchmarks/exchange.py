@@ -16,6 +16,12 @@ every thread; the machine is shared), ``--wall`` for wall-clock times. glTF and 
 measured by benchmarks/web.py.
 
     python benchmarks/exchange.py [--quick] [--runs=N] [--wall] [--only=resqml,omf,geoh5]
+        [--geoh5py=PYTHON]
+
+``--geoh5py=PYTHON`` (an interpreter with geoh5py, e.g. the ``.venv-geoh5`` that
+``make geoh5-check`` builds) adds the row ``read geoh5py``: geoh5py opening geobrep's file and
+reading the surface's vertices, cells and data, timed in a child process of its own (after a
+first read), next to geobrep's reads of the same file.
 """
 
 from __future__ import annotations
@@ -41,6 +47,43 @@ RUNS = next((int(a.split("=", 1)[1]) for a in sys.argv if a.startswith("--runs="
 CLOCK = time.perf_counter if "--wall" in sys.argv else time.process_time
 #: ``--only resqml,omf``: just these formats.
 ONLY = next((a.split("=", 1)[1].split(",") for a in sys.argv if a.startswith("--only=")), [])
+#: ``--geoh5py=PYTHON``: an interpreter that has geoh5py (it cannot share this environment).
+GEOH5PY = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--geoh5py=")), "")
+
+_GEOH5PY_READ = """
+import json, sys, time
+from geoh5py.workspace import Workspace
+clock = time.perf_counter if sys.argv[3] == "wall" else time.process_time
+def read():
+    with Workspace(sys.argv[1], mode="r") as ws:
+        (surface,) = ws.get_entity("horizon")
+        kept = [surface.vertices, surface.cells]
+        kept.extend(d.values for d in surface.children if hasattr(d, "values"))
+    return kept
+read()
+times = []
+for _ in range(int(sys.argv[2])):
+    start = clock(); read(); times.append(clock() - start)
+print(json.dumps(times))
+"""
+
+
+def _geoh5py_reads(path: Path) -> list[float] | None:
+    """geoh5py's read times of ``path`` in a child process of the ``--geoh5py`` interpreter."""
+    import json
+    import subprocess
+
+    clock = "wall" if CLOCK is time.perf_counter else "cpu"
+    done = subprocess.run(
+        [GEOH5PY, "-c", _GEOH5PY_READ, str(path), str(RUNS), clock],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    if done.returncode != 0:
+        print(f"geoh5py read failed: {done.stderr.strip().splitlines()[-1:]}")
+        return None
+    return [float(t) for t in json.loads(done.stdout)]
 
 
 def _surface(n_triangles: int) -> geobrep.Surface:
@@ -264,15 +307,20 @@ def _run(
             pair = [("ours", lambda: geobrep.read(path)), ("direct*", fast)]
             for key, action in pair[:: -1 if run % 2 else 1]:
                 times.setdefault(f"read* {key}", []).append(_timed(action))
+    if name == "geoh5" and GEOH5PY:
+        library = _geoh5py_reads(path)
+        if library:
+            times["read geoh5py direct"] = library
+            times["read geoh5py ours"] = times["read ours"]
     back = geobrep.read(path).surfaces[0]
     assert back.vertices.tobytes() == scene.surfaces[0].vertices.tobytes(), name
-    for op in ("write", "read", "read*"):
+    for op in ("write", "read", "read*", "read geoh5py"):
         if f"{op} ours" not in times:
             continue
         ours_t, theirs_t = times[f"{op} ours"], times[f"{op} direct" + ("*" in op) * "*"]
         (ob, om), (tb, tm) = (min(ours_t), median(ours_t)), (min(theirs_t), median(theirs_t))
         print(
-            f"{name:8}{op:7}{ob * 1e3:11.1f} /{om * 1e3:7.1f}{tb * 1e3:12.1f} /{tm * 1e3:7.1f}"
+            f"{name:8}{op:13}{ob * 1e3:11.1f} /{om * 1e3:7.1f}{tb * 1e3:12.1f} /{tm * 1e3:7.1f}"
             f"{ob / tb:12.2f}{om / tm:14.2f}"
         )
 
@@ -287,7 +335,7 @@ def main() -> None:
         f"{'wall-clock' if CLOCK is time.perf_counter else 'CPU'} time"
     )
     print(
-        f"{'format':8}{'op':7}{'geobrep best/median ms':>22}{'direct best/median ms':>22}"
+        f"{'format':8}{'op':13}{'geobrep best/median ms':>22}{'direct best/median ms':>22}"
         f"{'ratio best':>12}{'ratio median':>14}"
     )
     with tempfile.TemporaryDirectory() as tmp, warnings.catch_warnings():
