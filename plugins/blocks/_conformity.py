@@ -419,19 +419,22 @@ def _crossings(
     candidate pairs when the caller's broad phase (a wider margin) already found them (only
     their triangles are gathered then)."""
     local = soup.local(soup.vertices)
-    if pairs is None:
-        i, j = stored_pairs(soup.corners, soup.triangle_surface, margin=tol)
-    else:
-        i, j = _boxes_within(local, soup.triangles, *pairs, tol)
+    i, j = stored_pairs(soup.corners, soup.triangle_surface, margin=tol) if pairs is None else pairs
     if i.size == 0:
         return []
     # np.take: row gathers several times faster than fancy indexing on numpy 2.
     ti, tj = np.take(soup.triangles, i, axis=0), np.take(soup.triangles, j, axis=0)
+    # Triangles sharing a vertex (most candidates: neighbours across a shared line) first,
+    # then, for a caller's wider broad phase, boxes beyond the contact tolerance: both masks
+    # keep the order, so the pairs left are the same either way round.
     apart = np.ones(i.shape[0], dtype=np.bool_)
     for a in range(3):
         for b in range(3):
             apart &= ti[:, a] != tj[:, b]
     i, j, ti, tj = i[apart], j[apart], ti[apart], tj[apart]
+    if pairs is not None:
+        near = _boxes_within(local, ti, tj, tol)
+        i, j, ti, tj = i[near], j[near], ti[near], tj[near]
     first, second = np.take(local, ti, axis=0), np.take(local, tj, axis=0)
     hit = triangles_intersect(first, second, tol)
     i, j, first, second = i[hit], j[hit], first[hit], second[hit]
@@ -477,21 +480,26 @@ def _allowed_surfaces(soup: Soup, border: IntArray) -> IntArray:
     return _sorted_unique(np.repeat(ring_vertex, count) * n_surfaces + held_surface[rows])
 
 
-def _boxes_within(
-    local: FloatArray, triangles: IntArray, i: IntArray, j: IntArray, margin: float
-) -> tuple[IntArray, IntArray]:
-    """The pairs whose triangles' boxes (corners ``local[triangles]``), grown by ``margin``,
-    overlap; only the paired triangles are gathered."""
-    keep = np.ones(i.shape[0], dtype=np.bool_)
-    if i.size == 0:
-        return i, j
-    mine, theirs = np.take(triangles, i, axis=0), np.take(triangles, j, axis=0)
+def _boxes_within(local: FloatArray, mine: IntArray, theirs: IntArray, margin: float) -> BoolArray:
+    """Which pairs of triangles (vertex rows ``mine`` and ``theirs``, (K, 3), over corners
+    ``local``) have boxes, grown by ``margin``, that overlap; only the paired triangles are
+    gathered."""
+    keep = np.ones(mine.shape[0], dtype=np.bool_)
+    if mine.shape[0] == 0:
+        return keep
+    # Corner by corner (elementwise minima and maxima: numpy's reductions over an axis of
+    # three are several times slower).
     for axis in range(3):
         column = np.ascontiguousarray(local[:, axis])
-        one, other = column[mine], column[theirs]
-        keep &= one.min(axis=1) - margin <= other.max(axis=1) + margin
-        keep &= other.min(axis=1) - margin <= one.max(axis=1) + margin
-    return i[keep], j[keep]
+        one = [np.take(column, mine[:, k]) for k in range(3)]
+        other = [np.take(column, theirs[:, k]) for k in range(3)]
+        one_low = np.minimum(np.minimum(one[0], one[1]), one[2]) - margin
+        one_high = np.maximum(np.maximum(one[0], one[1]), one[2]) + margin
+        other_low = np.minimum(np.minimum(other[0], other[1]), other[2]) - margin
+        other_high = np.maximum(np.maximum(other[0], other[1]), other[2]) + margin
+        keep &= one_low <= other_high
+        keep &= other_low <= one_high
+    return keep
 
 
 #: The free border: edges (B, 2) one triangle uses, their vertices, each vertex's surface.
