@@ -359,7 +359,8 @@ def component_major(columns: FloatArray, triangles: IntArray) -> FloatArray:
     by_corner = np.ascontiguousarray(triangles.T)
     stored = np.empty((3, 3, triangles.shape[0]), dtype=np.float64)
     for k in range(3):
-        np.take(columns, by_corner[k], axis=1, out=stored[k])
+        for axis in range(3):  # 1-D gathers: faster than taking columns along axis 1
+            np.take(columns[axis], by_corner[k], out=stored[k, axis])
     return stored
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from blocks_models import grid_surface
 
-from geobrep.plugins.blocks._broad_phase import overlapping_pairs, stored_pairs
+from geobrep.plugins.blocks._broad_phase import component_major, overlapping_pairs, stored_pairs
 from geobrep.plugins.blocks._conformity import _crossings
 from geobrep.plugins.blocks._soup import Soup, build_soup
 
@@ -96,3 +96,12 @@ def test_crossings_whichever_pairs_they_start_from(seed: int) -> None:
         i, j = stored_pairs(soup.corners, soup.triangle_surface, margin)
         order = np.lexsort((j, i))
         assert defects(_crossings(soup, tol, (i[order], j[order]))) == own
+
+
+def test_component_major_gathers_the_corners() -> None:
+    rng = np.random.default_rng(3)
+    vertices = rng.normal(size=(500, 3))
+    triangles = rng.integers(0, 500, size=(2000, 3))
+    stored = component_major(np.ascontiguousarray(vertices.T), triangles)
+    assert stored.shape == (3, 3, 2000)
+    assert np.array_equal(stored, np.transpose(vertices[triangles], (1, 2, 0)))
