@@ -241,19 +241,48 @@ NOT_FOR_A_TSURF = (
 )
 
 
-def test_reading_a_tsurf_imports_only_what_it_needs() -> None:
+def _loaded_after_reading(name: str) -> list[str]:
+    """The modules of a fresh interpreter that imported geobrep and read ``data/gocad/name``."""
     result = subprocess.run(
-        [sys.executable, "-c", READ_PROBE, str(Path(__file__).parent / "data/gocad/2triangles.ts")],
+        [sys.executable, "-c", READ_PROBE, str(Path(__file__).parent / "data/gocad" / name)],
         capture_output=True,
         text=True,
         timeout=120,
         check=True,
     )
-    loaded = json.loads(result.stdout.splitlines()[-1])
-    below = tuple(f"{name}." for name in NOT_FOR_A_TSURF)
-    unneeded = [m for m in loaded if m.startswith(below) or m in NOT_FOR_A_TSURF]
+    loaded: list[str] = json.loads(result.stdout.splitlines()[-1])
+    return loaded
+
+
+def _among(loaded: list[str], modules: tuple[str, ...]) -> list[str]:
+    below = tuple(f"{name}." for name in modules)
+    return [m for m in loaded if m.startswith(below) or m in modules]
+
+
+def test_reading_a_tsurf_imports_only_what_it_needs() -> None:
+    loaded = _loaded_after_reading("2triangles.ts")
+    unneeded = _among(loaded, NOT_FOR_A_TSURF)
     assert not unneeded, unneeded
     assert "geobrep.adapters.gocad._reader" in loaded  # the probe did read through GOCAD
+
+
+#: What reading a Model3d must not import: the plugins (its blocks are built from its regions by
+#: the model, not by the blocks plugin), the other GOCAD readers and the writer, scipy, pyproj,
+#: meshio, and the command line's modules (argparse: the operation registry builds parsers only
+#: for the command line).
+NOT_FOR_A_MODEL3D = (
+    *(name for name in NOT_FOR_A_TSURF if name != "geobrep.adapters.gocad._model3d"),
+    "geobrep.cli",
+    "geobrep.batch",
+    "argparse",
+)
+
+
+def test_reading_a_model3d_imports_only_what_it_needs() -> None:
+    loaded = _loaded_after_reading("modelA1.ml")
+    unneeded = _among(loaded, NOT_FOR_A_MODEL3D)
+    assert not unneeded, unneeded
+    assert "geobrep.adapters.gocad._model3d" in loaded  # the probe did read a Model3d
 
 
 def test_validating_a_million_triangles(record_property: Callable[[str, object], None]) -> None:

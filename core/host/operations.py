@@ -25,8 +25,6 @@ Plugins register operations with the ``geobrep_register_operations`` hook
 
 from __future__ import annotations
 
-import argparse
-import json
 import types
 import typing
 import weakref
@@ -41,6 +39,8 @@ from geobrep.errors import OptionsError
 from geobrep.host.registry import RegisteredItem, Registry
 
 if TYPE_CHECKING:
+    import argparse
+
     from geobrep.model.scene import Scene
 
 __all__ = [
@@ -117,6 +117,8 @@ def comma_numbers(count: int | None = None, what: str = "numbers") -> Callable[[
     """A ``parse`` for ``a,b,c,d``: ``count`` comma-separated numbers (any count: None)."""
 
     def parse(text: str) -> list[float]:
+        import argparse  # the command line's: a library read imports neither it nor json
+
         try:
             values = [float(part) for part in text.replace(" ", "").split(",") if part]
         except ValueError:
@@ -139,6 +141,9 @@ def key_value(text: str) -> tuple[str, Any]:
     >>> key_value("surface.caps=false"), key_value("Surface=surface")
     (('surface.caps', False), ('Surface', 'surface'))
     """
+    import argparse
+    import json
+
     key, sep, value = text.partition("=")
     if not sep or not key.strip():
         raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got {text!r}")
@@ -283,6 +288,8 @@ def _choices(annotation: Any) -> tuple[Any, ...] | None:
 
 def _argument(name: str, info: FieldInfo) -> dict[str, Any]:
     """The ``add_argument`` keywords of a field (without the option strings)."""
+    import argparse
+
     cli = cli_of(info)
     annotation, _ = _unwrapped(info.annotation)
     keywords: dict[str, Any] = {"help": cli.help if cli.help is not None else info.description}
@@ -344,6 +351,8 @@ def options_from_args(model: type[BaseModel], args: argparse.Namespace | Mapping
     Raises:
         OptionsError: a value the model refuses, naming the option as it was typed.
     """
+    import argparse
+
     given = vars(args) if isinstance(args, argparse.Namespace) else dict(args)
     data = {name: given[name] for name in model.model_fields if name in given}
     for name, value in data.items():
