@@ -1057,3 +1057,21 @@ class TestTetMesh:
         values: dict[str, Any] = {"vertices": CUBE_VERTICES, "cells": [[0, 1, 3, 4]], "name": "t"}
         values.update(fields)
         invalid(lambda: TetMesh(**values), "TetMesh 't'", field, fragment)
+
+
+def test_structural_equality_of_plain_leaves_and_their_subclasses() -> None:
+    from geobrep.model.base import structurally_equal
+
+    class Loose(str):
+        def __eq__(self, other: object) -> bool:
+            return True
+
+        __hash__ = str.__hash__
+
+    assert structurally_equal({"a": (1, "x", None)}, {"a": [True, "x", None]})
+    assert not structurally_equal({"a": (1, "x", None)}, {"a": (1, "y", None)})
+    assert not structurally_equal("1", 1)
+    assert structurally_equal(Loose("a"), "b")  # a subclass keeps its own equality
+    assert structurally_equal(math.nan, math.nan)
+    assert not structurally_equal(np.zeros(2), "x")
+    assert not structurally_equal("x", np.zeros(2))

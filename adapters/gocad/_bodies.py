@@ -203,6 +203,8 @@ class _FileRuns:
         self._place: dict[int, tuple[int, int]] = {}  # run -> (group, first row)
         self._blocks: list[NDArray[np.float64] | IntArray | None] = []
         self._parsed: set[str] = set()
+        # keyword -> first-line width (blanks) -> its runs, in file order (made once)
+        self._groups: dict[str, dict[int, list[int]]] | None = None
 
     @classmethod
     def of(cls, source: Source) -> _FileRuns:
@@ -234,18 +236,21 @@ class _FileRuns:
             return parse_rows(self.source, [self.runs[i] for i in indices], integer)
         return block[offset : offset + count]
 
+    def _width_groups(self) -> dict[str, dict[int, list[int]]]:
+        """The runs of each keyword by the number of blanks of their first line (a blank
+        ending it aside), in file order."""
+        if self._groups is None:
+            data = self.source.data
+            self._groups = {}
+            first_ends = self.source.ends[[run.first - 1 for run in self.runs]].tolist()
+            for index, (run, first_end) in enumerate(zip(self.runs, first_ends, strict=True)):
+                width = data.count(b" ", run.start, first_end) - (data[first_end - 1] == 32)
+                self._groups.setdefault(run.keyword, {}).setdefault(width, []).append(index)
+        return self._groups
+
     def _parse_groups(self, keyword: str) -> None:
         self._parsed.add(keyword)
-        data = self.source.data
-        ends = self.source.ends
-        groups: dict[int, list[int]] = {}
-        for index, run in enumerate(self.runs):
-            if run.keyword != keyword:
-                continue
-            first_end = int(ends[run.first - 1])
-            width = data.count(b" ", run.start, first_end) - (data[first_end - 1] == 32)
-            groups.setdefault(width, []).append(index)
-        for indices in groups.values():
+        for indices in self._width_groups().get(keyword, {}).values():
             try:
                 block = parse_rows(self.source, [self.runs[i] for i in indices], False)
             except BulkParseError:

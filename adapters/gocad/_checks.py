@@ -111,8 +111,15 @@ def borders_on_patch_borders(
     triangle, corner = np.nonzero(near)
     a, b = faces[triangle, corner], faces[triangle, (corner + 1) % 3]
     keys = np.minimum(a, b) * n + np.maximum(a, b)
-    rows, counts = np.unique(np.column_stack([parts[triangle], keys]), axis=0, return_counts=True)
-    border_keys = np.unique(rows[counts == 1, 1])
+    patch = np.asarray(parts, dtype=np.int64)[triangle]
+    low = int(patch.min(initial=0))
+    span = int(patch.max(initial=0)) - low + 1
+    if float(span) * n * n < 2.0**62:  # (patch, edge) as one int64 key
+        combined, counts = np.unique((patch - low) * (n * n) + keys, return_counts=True)
+        border_keys = np.unique(combined[counts == 1] % (n * n))
+    else:
+        rows, counts = np.unique(np.column_stack([patch, keys]), axis=0, return_counts=True)
+        border_keys = np.unique(rows[counts == 1, 1])
     pair_keys = pairs.min(axis=1) * n + pairs.max(axis=1)
     on_border: NDArray[np.bool_] = np.isin(pair_keys, border_keys)
     return on_border

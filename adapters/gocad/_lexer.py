@@ -483,8 +483,8 @@ def _parse_block(
     if step < 2 or step * count != len(flat) or flat[::step].count(marker) != count:
         raise BulkParseError
     del flat[::step]
-    try:
-        array = np.fromiter(flat, dtype=np.float64, count=len(flat))
+    try:  # only numbers are left (the markers counted above): faster than np.fromiter
+        array = np.array(flat, dtype=np.float64)
     except (ValueError, TypeError, OverflowError) as exc:
         raise BulkParseError from exc
     return array.reshape(count, step - 1)

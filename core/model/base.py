@@ -25,8 +25,15 @@ def arrays_identical(a: Any, b: Any) -> bool:
     return bool(np.array_equal(bits_a, bits_b))
 
 
+#: Exact types whose values compare with ``==`` alone (no subclasses: they may override it).
+_PLAIN: frozenset[type] = frozenset({str, int, bool, type(None)})
+_SEQUENCES = (tuple, list)
+
+
 def structurally_equal(a: Any, b: Any) -> bool:
     """Deep equality that understands numpy arrays inside models, dicts and sequences."""
+    if type(a) in _PLAIN and type(b) in _PLAIN:  # the common leaves, before the costlier tests
+        return bool(a == b)
     if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
         return arrays_identical(a, b)
     if isinstance(a, BaseModel) or isinstance(b, BaseModel):
@@ -35,7 +42,7 @@ def structurally_equal(a: Any, b: Any) -> bool:
         )
     if isinstance(a, dict) and isinstance(b, dict):
         return a.keys() == b.keys() and all(structurally_equal(a[k], b[k]) for k in a)
-    if isinstance(a, tuple | list) and isinstance(b, tuple | list):
+    if isinstance(a, _SEQUENCES) and isinstance(b, _SEQUENCES):
         return len(a) == len(b) and all(structurally_equal(x, y) for x, y in zip(a, b, strict=True))
     if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
         return True  # a NaN no-data value equals itself, as NaN array entries do

@@ -70,6 +70,21 @@ def test_borders_on_patch_borders_as_defined(seed: int) -> None:
     assert not all(expected)
 
 
+@pytest.mark.parametrize("spread", ["negative", "beyond one key"])
+def test_border_answers_do_not_depend_on_how_patches_are_numbered(spread: str) -> None:
+    # patch numbers below zero, or so far apart that (patch, edge) no longer fits one int64
+    # key (the row-wise path), change nothing
+    _, faces, parts = _soup(4)
+    rng = np.random.default_rng(7)
+    edges = faces[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2)
+    pairs = np.concatenate([edges[rng.choice(edges.shape[0], 40)], rng.integers(0, 35, (10, 2))])
+    renumbered = parts - 5 if spread == "negative" else parts * 10**16
+    expected = borders_on_patch_borders(faces, parts, pairs).tolist()
+    assert any(expected)
+    assert not all(expected)
+    assert borders_on_patch_borders(faces, renumbered, pairs).tolist() == expected
+
+
 def test_32_bit_indices_give_the_same_answers() -> None:
     xyz, faces, parts = _soup(9)
     xyz = np.concatenate([xyz, np.random.default_rng(9).normal(size=(70_000, 3))])
