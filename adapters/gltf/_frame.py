@@ -62,6 +62,16 @@ class OffsetFrame:
     def to_world(self, local: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.asarray(local, np.float64) + np.asarray(self.origin, np.float64)
 
+    def world_from_y_up(self, points: NDArray[Any]) -> NDArray[np.float64]:
+        """``to_world(from_y_up(points))`` in one pass into one array, the same values bit for
+        bit (each coordinate widened to float64, then the origin added)."""
+        x, y, z = self.origin
+        world = np.empty((points.shape[0], 3), dtype=np.float64)
+        np.add(points[:, 0], x, out=world[:, 0], dtype=np.float64)
+        np.subtract(y, points[:, 2], out=world[:, 1], dtype=np.float64)
+        np.add(points[:, 1], z, out=world[:, 2], dtype=np.float64)
+        return world
+
     def describe(self) -> dict[str, Any]:
         return {"frame": "offset", "origin": list(self.origin)}
 

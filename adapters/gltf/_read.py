@@ -41,7 +41,8 @@ class _File:
 
     def __init__(self, path: Path) -> None:
         pygltflib = import_pygltflib("reading glTF files")
-        head = path.read_bytes()[:12]
+        with path.open("rb") as stream:  # the magic only (the whole file is read once, below)
+            head = stream.read(12)
         if len(head) < 12 or head[:4] != b"glTF":
             raise FormatError("not a binary glTF file (no 'glTF' magic)", path)
         try:
@@ -136,9 +137,13 @@ def _own_entity(file: _File, node: Any, frame: Frame) -> Entity | None:
     if kind not in ("Surface", "PolyLine", "PointSet"):
         return None
     primitive = file.gltf.meshes[node.mesh].primitives[0]
-    positions = file.accessor(primitive.attributes.POSITION).astype(np.float64)
+    positions = file.accessor(primitive.attributes.POSITION)
+    if isinstance(frame, OffsetFrame):
+        vertices = frame.world_from_y_up(positions)
+    else:
+        vertices = frame.to_world(from_y_up(positions.astype(np.float64)))
     fields: dict[str, Any] = {
-        "vertices": frame.to_world(from_y_up(positions)),
+        "vertices": vertices,
         "id": meta.get("id"),
         "name": meta.get("name", ""),
         "kind": meta.get("kind"),
