@@ -62,6 +62,16 @@ class OffsetFrame:
     def to_world(self, local: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.asarray(local, np.float64) + np.asarray(self.origin, np.float64)
 
+    def y_up_from_world(self, world: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``to_y_up(to_local(world))`` in one pass into one array, the same values bit for bit."""
+        x, y, z = self.origin
+        y_up = np.empty((world.shape[0], 3), dtype=np.float64)
+        np.subtract(world[:, 0], x, out=y_up[:, 0])
+        np.subtract(world[:, 2], z, out=y_up[:, 1])
+        np.subtract(world[:, 1], y, out=y_up[:, 2])
+        np.negative(y_up[:, 2], out=y_up[:, 2])
+        return y_up
+
     def world_from_y_up(self, points: NDArray[Any]) -> NDArray[np.float64]:
         """``to_world(from_y_up(points))`` in one pass into one array, the same values bit for
         bit (each coordinate widened to float64, then the origin added)."""

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from geobrep.adapters.colors import RGBA, scene_colours
 from geobrep.adapters.display import drawn_meshes
-from geobrep.adapters.gltf._frame import Frame, to_y_up
+from geobrep.adapters.gltf._frame import Frame, OffsetFrame, to_y_up
 from geobrep.errors import import_optional
 from geobrep.model.entities import Block, Entity, PolyLine, Surface
 from geobrep.model.properties import PropertyMap
@@ -167,13 +167,22 @@ def _add_mesh(
     """One node, mesh and material for ``geometry`` (``source`` is the entity it shows;
     ``place``: where a tile's piece of a split mesh sits in the whole, arrays kept exactly)."""
     world = np.asarray(geometry.vertices, np.float64)  # type: ignore[attr-defined]
-    local = frame.to_local(world)
-    y_up = to_y_up(local)
+    if isinstance(frame, OffsetFrame):
+        y_up = frame.y_up_from_world(world)
+        if len(y_up):  # local (x, y, z) is y-up (x, -z, y)
+            low, high = y_up.min(axis=0), y_up.max(axis=0)
+            out.low = np.minimum(out.low, [low[0], -high[2], low[1]])
+            out.high = np.maximum(out.high, [high[0], -low[2], high[1]])
+    else:
+        local = frame.to_local(world)
+        y_up = to_y_up(local)
+        if len(local):
+            out.low = np.minimum(out.low, local.min(axis=0))
+            out.high = np.maximum(out.high, local.max(axis=0))
     single = y_up.astype(np.float32)
-    if len(local):
-        out.rounding = max(out.rounding, float(np.abs(single - y_up).max()))
-        out.low = np.minimum(out.low, local.min(axis=0))
-        out.high = np.maximum(out.high, local.max(axis=0))
+    if len(y_up):
+        error = np.subtract(single, y_up)
+        out.rounding = max(out.rounding, float(np.abs(error, out=error).max()))
     row = len(out.rows)
     attributes = {
         "POSITION": buffer.accessor(single, _FLOAT, "VEC3", _ARRAY_BUFFER, True),
