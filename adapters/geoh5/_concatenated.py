@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import json
 import re
+from collections.abc import Iterator
 from typing import Any
 
 import h5py
@@ -211,21 +212,30 @@ def _unique(name: str, taken: dict[str, Any]) -> str:
     return f"{name} ({n})"
 
 
+def _table_columns(
+    hole: _Hole, idents: list[str], rows: tuple[int, ...], what: str, skipped: list[str]
+) -> Iterator[tuple[str, dict[str, Any], NDArray[Any]]]:
+    """``(name, record, values)`` of each data column of a table whose rows have shape
+    ``rows``; a column of another length is reported in ``skipped`` and left out."""
+    for ident in idents:
+        if ident not in hole.data:
+            continue
+        record, values = hole.data[ident]
+        name = text(record.get("Name", ""))
+        values = _as_read(values)
+        if values.shape != rows:
+            skipped.append(f"drillhole {hole.name!r}: {what} data {name!r} not one per {what}")
+            continue
+        yield name, record, values
+
+
 def _depth_table(hole: _Hole, members: list[str], well: dict[str, Any], skipped: list[str]) -> None:
     depth_id, *rest = members
     if depth_id not in hole.data:
         skipped.append(f"drillhole {hole.name!r}: a depth table without its depths")
         return
     depth = _as_read(hole.data[depth_id][1]).astype(np.float64)
-    for ident in rest:
-        if ident not in hole.data:
-            continue
-        record, values = hole.data[ident]
-        name = text(record.get("Name", ""))
-        values = _as_read(values)
-        if values.shape != depth.shape:
-            skipped.append(f"drillhole {hole.name!r}: depth data {name!r} not one per depth")
-            continue
+    for name, record, values in _table_columns(hole, rest, depth.shape, "depth", skipped):
         keep = ~_unsampled(values) & np.isfinite(depth)
         primitive = hole.primitive(record)
         if primitive == "Referenced":
@@ -265,15 +275,7 @@ def _interval_table(
             f"drillhole {hole.name!r}: interval {row} ends at {bases[row]} above its top "
             f"{tops[row]}"
         )
-    for ident in members[2:]:
-        if ident not in hole.data:
-            continue
-        record, values = hole.data[ident]
-        name = text(record.get("Name", ""))
-        values = _as_read(values)
-        if values.shape != tops.shape:
-            skipped.append(f"drillhole {hole.name!r}: interval data {name!r} not one per interval")
-            continue
+    for name, record, values in _table_columns(hole, members[2:], tops.shape, "interval", skipped):
         keep = placed & ~_unsampled(values)
         primitive = hole.primitive(record)
         if primitive == "Referenced":

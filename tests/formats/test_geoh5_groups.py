@@ -288,3 +288,19 @@ def test_the_wells_to_a_format_of_one_well(
     back = geobrep.read(target)
     assert len(back.entities) == 1
     np.testing.assert_allclose(back.entities[0].md, scene["DH-1"].md)
+
+
+def test_a_column_not_one_per_row_of_its_table_is_reported(tmp_path: Path) -> None:
+    def shorten(concat: Any) -> None:
+        index = concat["Index/gr"][()]
+        index["Size"][0] -= 1  # the first drillhole's 'gr' now one value short of its depths
+        concat["Index/gr"][...] = index
+
+    back = geobrep.read(_damage(tmp_path, shorten))
+    skipped = back.metadata[SKIPPED_ON_READ]
+    short = [s for s in skipped if "depth data 'gr' not one per depth" in s]
+    assert len(short) == 1
+    whole = geobrep.read(FILE)
+    assert sum(1 for w in back.wells for name in w.logs if name.startswith("gr")) == (
+        sum(1 for w in whole.wells for name in w.logs if name.startswith("gr")) - 1
+    )
