@@ -17,8 +17,10 @@ Registers two formats (extra ``web``; 3D Tiles also need pyproj, extra ``gis``):
   ``longitude``, ``latitude`` and ``height`` say where its centre goes.
 
 pygltflib (pure Python, maintained, a complete typed model of the glTF 2.0 schema with
-extras/extensions as plain JSON and binary-chunk handling) writes and loads the container;
-geobrep builds the buffers with numpy, so writing 1M triangles costs a few array copies.
+extras/extensions as plain JSON and binary-chunk handling) loads the container. The writer
+builds the JSON document and the buffers with numpy and writes the .glb container itself (two
+chunk headers), the arrays going to the file without a copy (:mod:`._write` says why); the
+tests read what it writes with pygltflib and trimesh.
 """
 
 from __future__ import annotations
@@ -102,7 +104,7 @@ def _write_glb(scene: Scene, path: Path, options: GltfOptions) -> None:
     content = build_glb(
         scene, _origin(scene, options.origin), blocks=options.blocks, written=written
     )
-    path.write_bytes(content.data)
+    content.write_to(path)
 
 
 def _write_tiles(scene: Scene, path: Path, options: TilesOptions) -> None:

@@ -16,6 +16,8 @@ mapping 3D Tiles undoes when it loads glTF content.
 
 from __future__ import annotations
 
+import threading
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -118,7 +120,7 @@ class EnuFrame:
     def from_crs(cls, crs: CRS, anchor: tuple[float, float, float]) -> EnuFrame:
         to_ecef = _transformer(crs, inverse=False)
         ecef = np.array(to_ecef.transform(*anchor), dtype=np.float64)
-        to_geodetic = _pyproj().Transformer.from_crs(_ECEF, "EPSG:4979", always_xy=True)
+        to_geodetic = _between(_ECEF, "EPSG:4979")
         lon, lat, height = to_geodetic.transform(*ecef)
         return cls(anchor, crs, (float(lon), float(lat), float(height)), _floats(ecef))
 
@@ -126,7 +128,7 @@ class EnuFrame:
     def from_geodetic(
         cls, anchor: tuple[float, float, float], longitude: float, latitude: float, height: float
     ) -> EnuFrame:
-        to_ecef = _pyproj().Transformer.from_crs("EPSG:4979", _ECEF, always_xy=True)
+        to_ecef = _between("EPSG:4979", _ECEF)
         x, y, z = to_ecef.transform(longitude, latitude, height)
         return cls(anchor, None, (longitude, latitude, height), _floats((x, y, z)))
 
@@ -178,7 +180,36 @@ def _pyproj() -> Any:
     return import_optional("pyproj", "gis", "georeferencing 3D Tiles")
 
 
+_TRANSFORMERS = threading.local()
+"""Each thread's pyproj transformers by CRS and direction (a transformer takes about 10 ms to
+make; pyproj's are not to be shared between threads)."""
+
+
+def _cached(key: tuple[str, str], make: Callable[[], Any]) -> Any:
+    """This thread's transformer for ``key``, made by ``make`` the first time."""
+    cache: dict[tuple[str, str], Any] = _TRANSFORMERS.__dict__.setdefault("cache", {})
+    if key not in cache:
+        if len(cache) >= 16:
+            cache.clear()
+        cache[key] = make()
+    return cache[key]
+
+
+def _between(source: str, target: str) -> Any:
+    """pyproj's transformer from ``source`` to ``target`` (CRS names), x/y as lon/lat order."""
+    return _cached(
+        (source, target),
+        lambda: _pyproj().Transformer.from_crs(source, target, always_xy=True),
+    )
+
+
 def _transformer(crs: CRS, *, inverse: bool) -> Any:
+    """pyproj's transformer between ``crs`` (made 3D) and ECEF."""
+    key = (crs.model_dump_json(), "from ECEF" if inverse else "to ECEF")
+    return _cached(key, lambda: _new_transformer(crs, inverse=inverse))
+
+
+def _new_transformer(crs: CRS, *, inverse: bool) -> Any:
     """pyproj's transformer between ``crs`` (made 3D) and ECEF."""
     pyproj = _pyproj()
     from geobrep.gis.crs_ops import parse_crs

@@ -50,11 +50,11 @@ class _File:
         except Exception as exc:
             raise FormatError(f"not a valid glTF file: {type(exc).__name__}: {exc}", path) from exc
         self.path = path
-        self.blob: bytes = self.gltf.binary_blob() or b""
+        self.blob = memoryview(self.gltf.binary_blob() or b"")  # views slice it without a copy
         if len(self.gltf.nodes) > _MAX_NODES:
             raise FormatError(f"{len(self.gltf.nodes)} nodes: more than {_MAX_NODES}", path)
 
-    def view(self, index: int) -> tuple[bytes, int]:
+    def view(self, index: int) -> tuple[memoryview, int]:
         """The bytes of buffer view ``index`` and its byte stride (0: tightly packed)."""
         views = self.gltf.bufferViews
         if not 0 <= index < len(views):

@@ -59,38 +59,47 @@ def splittable(geometry: Entity) -> bool:
 
 
 def _halves(ids: IntArray, centres: NDArray[np.float64], limit: int) -> list[Any]:
-    """The k-d tree of element ``ids`` (nested lists of id arrays), leaves of ``limit``."""
+    """The k-d tree of element ``ids`` (nested lists of id arrays, each in increasing order),
+    leaves of ``limit``; ``centres`` holds one row per axis (a centre's coordinates, or any
+    fixed multiple of them)."""
     if len(ids) <= limit:
         return [ids]
-    points = centres[ids]
-    axis = int(np.argmax(np.ptp(points, axis=0)))
+    columns = [axis[ids] for axis in centres]
+    axis = int(np.argmax([np.ptp(column) for column in columns]))
     half = len(ids) // 2
-    order = np.argpartition(points[:, axis], half)
-    lower, upper = np.sort(ids[order[:half]]), np.sort(ids[order[half:]])
-    return [_halves(lower, centres, limit), _halves(upper, centres, limit)]
+    lower = np.zeros(len(ids), bool)
+    lower[np.argpartition(columns[axis], half)[:half]] = True
+    return [_halves(ids[lower], centres, limit), _halves(ids[~lower], centres, limit)]
 
 
-def _surface_part(surface: Surface, source: Entity, faces: IntArray, first: bool) -> Part:
-    """The leaf of ``surface`` holding ``faces`` (the first leaf also holds loose vertices)."""
+def _surface_part(
+    surface: Surface, source: Entity, faces: IntArray, loose: NDArray[np.bool_] | None
+) -> Part:
+    """The leaf of ``surface`` holding ``faces`` (and the ``loose`` vertices, no triangle's)."""
     n = surface.n_vertices
-    used = np.zeros(n, bool)
-    used[surface.faces[faces].ravel()] = True
-    if first:  # vertices no triangle uses travel in the first leaf
-        loose = np.ones(n, bool)
-        loose[surface.faces.ravel()] = False
-        used |= loose
-    vertex_ids = np.flatnonzero(used).astype(np.int64)
-    local = np.cumsum(used, dtype=np.int64) - 1
+    corners = np.asarray(surface.faces)[faces]
+    used = np.zeros(n, bool) if loose is None else loose.copy()
+    used[corners] = True
+    vertex_ids = np.flatnonzero(used)
+    local = np.cumsum(used, dtype=np.int64)
+    local -= 1
     labels = None if surface.patch_labels is None else surface.patch_labels[faces]
     geometry = surface.replace(
         vertices=surface.vertices[vertex_ids],
-        faces=local[surface.faces[faces]],
+        faces=local[corners],
         patch_labels=labels,
         point_data=surface.point_data.take(vertex_ids),
         cell_data=surface.cell_data.take(faces),
     )
     shown = geometry if source is surface else source
     return Part(geometry, shown, vertex_ids, faces, n, surface.n_faces)
+
+
+def _loose(surface: Surface) -> NDArray[np.bool_]:
+    """Which vertices of ``surface`` no triangle uses (they travel in the first leaf)."""
+    loose = np.ones(surface.n_vertices, bool)
+    loose[np.asarray(surface.faces)] = False
+    return loose
 
 
 def _points_part(points: PointSet, source: Entity, ids: IntArray) -> Part:
@@ -103,7 +112,7 @@ def _parts(mesh: Entity, source: Entity, tree: list[Any], first: list[bool]) -> 
     if len(tree) == 1:
         ids = tree[0]
         if isinstance(mesh, Surface):
-            part = _surface_part(mesh, source, ids, first[0])
+            part = _surface_part(mesh, source, ids, _loose(mesh) if first[0] else None)
         else:
             assert isinstance(mesh, PointSet)
             part = _points_part(mesh, source, ids)
@@ -116,11 +125,13 @@ def split_mesh(geometry: Entity, source: Entity, limit: int) -> SplitTree:
     """``geometry`` (a surface or point set showing ``source``) as a k-d tree of leaves of at
     most ``limit`` triangles (points)."""
     if isinstance(geometry, Surface):
-        corners = np.take(np.asarray(geometry.vertices), geometry.faces, axis=0)
-        centres = corners.mean(axis=1)
+        columns = np.ascontiguousarray(np.asarray(geometry.vertices, np.float64).T)
+        faces = np.asarray(geometry.faces).T
+        # three times the centroids, one row per axis
+        centres = np.stack([c[faces[0]] + c[faces[1]] + c[faces[2]] for c in columns])
         count = geometry.n_faces
     elif isinstance(geometry, PointSet):
-        centres, count = np.asarray(geometry.vertices), geometry.n_points
+        centres, count = np.asarray(geometry.vertices, np.float64).T, geometry.n_points
     else:
         raise TypeError(f"{geometry.type} meshes are not split")
     tree = _halves(np.arange(count, dtype=np.int64), centres, max(1, limit))

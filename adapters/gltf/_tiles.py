@@ -197,7 +197,7 @@ class _TileWriter:
         name = f"{self.stem}.glb" if alone else f"{self.stem}_{self.count}.glb"
         self.count += 1
         with atomic_write(self.path.parent / name) as temporary:
-            temporary.write_bytes(content.data)
+            content.write_to(temporary)
         low, high = content.local_low, content.local_high
         if not content.meshes or not np.isfinite(low).all():
             low = high = np.zeros(3)

@@ -1,4 +1,4 @@
-"""A scene as a glTF 2.0 binary (.glb) through pygltflib: one named node and mesh per entity.
+"""A scene as a glTF 2.0 binary (.glb): one named node and mesh per entity.
 
 Surfaces are TRIANGLES, polylines LINES, point sets POINTS, each with a material of the
 entity's colour (:func:`geobrep.adapters.colors.scene_colours`); every block (but the universe)
@@ -9,11 +9,18 @@ names, polyline parts, and every property as raw little-endian bytes in a buffer
 binary chunk (float64 stays float64). Each primitive also carries an EXT_mesh_features feature
 id (``_FEATURE_ID_0``) into an EXT_structural_metadata property table of the meshes (name,
 kind, entity id, unit), so 3D Tiles viewers show what a picked object is.
+
+The JSON document is built as plain dicts and the binary container (a 12-byte header and two
+chunk headers, glTF 2.0 section 4.4) written here, the arrays handed to the file from their own
+memory: pygltflib's writer would turn the document into its dataclasses (about 25 ms a file)
+and copy the binary chunk twice. pygltflib reads (:mod:`._read`), and the tests load every
+kind of file written here with pygltflib and trimesh.
 """
 
 from __future__ import annotations
 
 import json
+import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Final
@@ -25,6 +32,7 @@ from geobrep.adapters.colors import RGBA, scene_colours
 from geobrep.adapters.display import drawn_meshes
 from geobrep.adapters.gltf._frame import Frame, OffsetFrame, to_y_up
 from geobrep.errors import import_optional
+from geobrep.geometry.bbox import column_extremes
 from geobrep.model.entities import Block, Entity, PolyLine, Surface
 from geobrep.model.properties import PropertyMap
 from geobrep.model.scene import Scene
@@ -45,23 +53,36 @@ def import_pygltflib(feature: str) -> Any:
     return import_optional("pygltflib", "web", feature)
 
 
+def _bytes_of(data: bytes | NDArray[Any]) -> memoryview:
+    """The bytes of ``data`` without a copy (an array is made contiguous first if it is not)."""
+    if isinstance(data, np.ndarray):
+        return memoryview(np.ascontiguousarray(data).reshape(-1).view(np.uint8))
+    return memoryview(data)
+
+
 @dataclass
 class _Buffer:
-    """The binary chunk being built: 4-byte aligned buffer views and their accessors."""
+    """The binary chunk being built: 4-byte aligned buffer views and their accessors.
 
-    chunks: list[bytes] = field(default_factory=list)
+    The views hold the arrays' own memory (no copy); :func:`glb_parts` hands them to the file.
+    """
+
+    chunks: list[memoryview] = field(default_factory=list)
     size: int = 0
     views: list[dict[str, Any]] = field(default_factory=list)
     accessors: list[dict[str, Any]] = field(default_factory=list)
 
-    def view(self, data: bytes, target: int | None = None) -> int:
-        entry: dict[str, Any] = {"buffer": 0, "byteOffset": self.size, "byteLength": len(data)}
+    def view(self, data: bytes | NDArray[Any], target: int | None = None) -> int:
+        chunk = _bytes_of(data)
+        entry: dict[str, Any] = {"buffer": 0, "byteOffset": self.size, "byteLength": chunk.nbytes}
         if target is not None:
             entry["target"] = target
         self.views.append(entry)
-        padding = (-len(data)) % 4
-        self.chunks.append(data + b"\0" * padding)
-        self.size += len(data) + padding
+        self.chunks.append(chunk)
+        padding = (-chunk.nbytes) % 4
+        if padding:
+            self.chunks.append(memoryview(b"\0" * padding))
+        self.size += chunk.nbytes + padding
         return len(self.views) - 1
 
     def raw(self, array: NDArray[Any]) -> dict[str, Any]:
@@ -69,37 +90,72 @@ class _Buffer:
         values = np.ascontiguousarray(array)
         little = values.astype(values.dtype.newbyteorder("<"), copy=False)
         return {
-            "bufferView": self.view(little.tobytes()),
+            "bufferView": self.view(little),
             "dtype": little.dtype.str,
             "shape": list(values.shape),
         }
 
     def accessor(
-        self, array: NDArray[Any], component: int, kind: str, target: int | None, bounds: bool
+        self,
+        array: NDArray[Any],
+        component: int,
+        kind: str,
+        target: int | None,
+        bounds: tuple[NDArray[Any], NDArray[Any]] | None = None,
     ) -> int:
+        """An accessor of ``array``; ``bounds`` (its per-component minimum and maximum, of the
+        array's own dtype) become the accessor's ``min`` and ``max``."""
         entry: dict[str, Any] = {
-            "bufferView": self.view(np.ascontiguousarray(array).tobytes(), target),
+            "bufferView": self.view(array, target),
             "componentType": component,
             "count": int(array.shape[0]),
             "type": kind,
         }
-        if bounds and array.shape[0]:
-            entry["min"] = [float(v) for v in array.min(axis=0)]
-            entry["max"] = [float(v) for v in array.max(axis=0)]
+        if bounds is not None and array.shape[0]:
+            entry["min"] = [float(v) for v in bounds[0]]
+            entry["max"] = [float(v) for v in bounds[1]]
         self.accessors.append(entry)
         return len(self.accessors) - 1
 
 
+_GLB_MAGIC, _GLB_VERSION = 0x46546C67, 2
+_JSON_CHUNK, _BIN_CHUNK = 0x4E4F534A, 0x004E4942
+
+
+def glb_parts(document: dict[str, Any], buffer: _Buffer) -> list[memoryview]:
+    """The pieces of a .glb file, in order: header, JSON chunk (padded with spaces), binary
+    chunk (the buffer views, each padded with zeros to 4 bytes). The arrays are not copied."""
+    text = json.dumps(document, allow_nan=False, separators=(",", ":")).encode("utf-8")
+    text += b" " * ((-len(text)) % 4)
+    chunks = [memoryview(struct.pack("<II", len(text), _JSON_CHUNK) + text)]
+    if buffer.size:
+        chunks.append(memoryview(struct.pack("<II", buffer.size, _BIN_CHUNK)))
+        chunks.extend(buffer.chunks)
+    total = 12 + sum(c.nbytes for c in chunks)
+    return [memoryview(struct.pack("<III", _GLB_MAGIC, _GLB_VERSION, total)), *chunks]
+
+
 @dataclass
 class GlbContent:
-    """What :func:`build_glb` made: the file's bytes and what it measured."""
+    """What :func:`build_glb` made: the file's pieces and what it measured."""
 
-    data: bytes
+    parts: list[memoryview]
+    """The file's bytes in pieces (:func:`glb_parts`): write them in order."""
     max_rounding_m: float
     """Largest distance a vertex moved by the float32 rounding, in world units (metres)."""
     local_low: NDArray[np.float64]
     local_high: NDArray[np.float64]
     meshes: int
+
+    @property
+    def data(self) -> bytes:
+        """The whole file as one bytes object (a copy of every array)."""
+        return b"".join(self.parts)
+
+    def write_to(self, path: Path) -> None:
+        """Write the file to ``path``, the arrays straight from their own memory."""
+        with path.open("wb") as file:
+            file.writelines(self.parts)
 
 
 def _properties(buffer: _Buffer, props: PropertyMap) -> dict[str, Any]:
@@ -155,6 +211,51 @@ class _Meshes:
     high: NDArray[np.float64] = field(default_factory=lambda: np.full(3, -np.inf))
 
 
+_BLOCK_ROWS: Final = 1 << 16
+"""Vertices converted per pass: the float64 block stays in cache while it is rounded,
+measured and bounded."""
+
+
+@dataclass
+class _Positions:
+    """A mesh's float32 y-up positions and what was measured on the float64 values."""
+
+    single: NDArray[np.float32]
+    low: NDArray[np.float64]
+    """Per-axis minimum of the float64 y-up coordinates (``inf`` for no vertex)."""
+    high: NDArray[np.float64]
+    rounding: float
+    """Largest change of a coordinate by the float32 rounding."""
+
+    @property
+    def float32_bounds(self) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+        """The per-axis minimum and maximum of :attr:`single`: rounding to float32 keeps order,
+        so they are the float64 bounds rounded."""
+        return self.low.astype(np.float32), self.high.astype(np.float32)
+
+
+def _positions(frame: Frame, world: NDArray[np.float64]) -> _Positions:
+    """``world`` in ``frame``, y-up, as float32, converted block by block."""
+    n = world.shape[0]
+    if isinstance(frame, OffsetFrame):
+        y_up_of = frame.y_up_from_world
+        source = world
+    else:
+        local = frame.to_local(world)
+        y_up_of, source = to_y_up, local
+    single = np.empty((n, 3), np.float32)
+    low, high, rounding = np.full(3, np.inf), np.full(3, -np.inf), 0.0
+    for start in range(0, n, _BLOCK_ROWS):
+        y_up = y_up_of(source[start : start + _BLOCK_ROWS])
+        block = single[start : start + len(y_up)]
+        np.copyto(block, y_up, casting="same_kind")
+        block_low, block_high = column_extremes(y_up)
+        low, high = np.minimum(low, block_low), np.maximum(high, block_high)
+        error = np.subtract(block, y_up)
+        rounding = max(rounding, float(np.abs(error, out=error).max()))
+    return _Positions(single, low, high, rounding)
+
+
 def _add_mesh(
     out: _Meshes,
     buffer: _Buffer,
@@ -167,27 +268,20 @@ def _add_mesh(
     """One node, mesh and material for ``geometry`` (``source`` is the entity it shows;
     ``place``: where a tile's piece of a split mesh sits in the whole, arrays kept exactly)."""
     world = np.asarray(geometry.vertices, np.float64)  # type: ignore[attr-defined]
-    if isinstance(frame, OffsetFrame):
-        y_up = frame.y_up_from_world(world)
-        if len(y_up):  # local (x, y, z) is y-up (x, -z, y)
-            low, high = y_up.min(axis=0), y_up.max(axis=0)
-            out.low = np.minimum(out.low, [low[0], -high[2], low[1]])
-            out.high = np.maximum(out.high, [high[0], -low[2], high[1]])
-    else:
-        local = frame.to_local(world)
-        y_up = to_y_up(local)
-        if len(local):
-            out.low = np.minimum(out.low, local.min(axis=0))
-            out.high = np.maximum(out.high, local.max(axis=0))
-    single = y_up.astype(np.float32)
-    if len(y_up):
-        error = np.subtract(single, y_up)
-        out.rounding = max(out.rounding, float(np.abs(error, out=error).max()))
+    positions = _positions(frame, world)
+    single = positions.single
+    if len(single):  # local (x, y, z) is y-up (x, -z, y)
+        low, high = positions.low, positions.high
+        out.low = np.minimum(out.low, [low[0], -high[2], low[1]])
+        out.high = np.maximum(out.high, [high[0], -low[2], high[1]])
+        out.rounding = max(out.rounding, positions.rounding)
     row = len(out.rows)
     attributes = {
-        "POSITION": buffer.accessor(single, _FLOAT, "VEC3", _ARRAY_BUFFER, True),
+        "POSITION": buffer.accessor(
+            single, _FLOAT, "VEC3", _ARRAY_BUFFER, positions.float32_bounds
+        ),
         "_FEATURE_ID_0": buffer.accessor(
-            np.full(len(single), row, np.float32), _FLOAT, "SCALAR", _ARRAY_BUFFER, False
+            np.full(len(single), row, np.float32), _FLOAT, "SCALAR", _ARRAY_BUFFER
         ),
     }
     primitive: dict[str, Any] = {
@@ -202,7 +296,7 @@ def _add_mesh(
     }
     indices = _indices(geometry)
     if indices is not None:
-        primitive["indices"] = buffer.accessor(indices, _UINT, "SCALAR", _ELEMENT_BUFFER, False)
+        primitive["indices"] = buffer.accessor(indices, _UINT, "SCALAR", _ELEMENT_BUFFER)
     label = source.name or source.label
     out.materials.append(
         {
@@ -287,7 +381,6 @@ def build_glb(
     some of them: one tile of a tileset; ``places`` (beside ``meshes``) says which of them are
     pieces of a mesh the tileset split, and where they sit in it.
     """
-    pygltflib = import_pygltflib("writing glTF files")
     kept = written if written is not None else scene
     colours = scene_colours(scene)
     buffer, out = _Buffer(), _Meshes()
@@ -321,10 +414,7 @@ def build_glb(
     document["accessors"] = buffer.accessors
     document["bufferViews"] = buffer.views
     document["buffers"] = [{"byteLength": buffer.size}]
-    gltf = pygltflib.GLTF2.from_json(json.dumps(document, allow_nan=False))
-    gltf.set_binary_blob(b"".join(buffer.chunks))
-    data = b"".join(gltf.save_to_bytes())
-    return GlbContent(data, out.rounding, out.low, out.high, len(out.meshes))
+    return GlbContent(glb_parts(document, buffer), out.rounding, out.low, out.high, len(out.meshes))
 
 
 def write_glb(
@@ -332,5 +422,5 @@ def write_glb(
 ) -> GlbContent:
     """Write ``scene`` to ``path`` (see :func:`build_glb`)."""
     content = build_glb(scene, frame, blocks=blocks, written=written)
-    path.write_bytes(content.data)
+    content.write_to(path)
     return content
