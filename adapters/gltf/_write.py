@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import json
 import struct
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Final
@@ -56,7 +57,7 @@ def import_pygltflib(feature: str) -> Any:
 def _bytes_of(data: bytes | NDArray[Any]) -> memoryview:
     """The bytes of ``data`` without a copy (an array is made contiguous first if it is not)."""
     if isinstance(data, np.ndarray):
-        return memoryview(np.ascontiguousarray(data).reshape(-1).view(np.uint8))
+        return memoryview(np.ascontiguousarray(data).reshape(-1).view(np.uint8).data)
     return memoryview(data)
 
 
@@ -237,9 +238,9 @@ class _Positions:
 def _positions(frame: Frame, world: NDArray[np.float64]) -> _Positions:
     """``world`` in ``frame``, y-up, as float32, converted block by block."""
     n = world.shape[0]
+    y_up_of: Callable[[NDArray[np.float64]], NDArray[np.float64]]
     if isinstance(frame, OffsetFrame):
-        y_up_of = frame.y_up_from_world
-        source = world
+        y_up_of, source = frame.y_up_from_world, world
     else:
         local = frame.to_local(world)
         y_up_of, source = to_y_up, local
