@@ -14,6 +14,7 @@ chunk before it is read, and counts are bounded by the file's size.
 
 from __future__ import annotations
 
+import struct
 from pathlib import Path
 from typing import Any, Final
 
@@ -32,6 +33,7 @@ from geobrep.model.scene import Group, Scene
 __all__ = ["read_glb", "read_glb_parts"]
 
 _COMPONENTS: Final = {5120: "i1", 5121: "u1", 5122: "<i2", 5123: "<u2", 5125: "<u4", 5126: "<f4"}
+_JSON_CHUNK, _BIN_CHUNK = 0x4E4F534A, 0x004E4942
 _WIDTH: Final = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
 _MAX_NODES: Final = 100_000
 
@@ -41,18 +43,52 @@ class _File:
 
     def __init__(self, path: Path) -> None:
         pygltflib = import_pygltflib("reading glTF files")
-        with path.open("rb") as stream:  # the magic only (the whole file is read once, below)
+        self.path = path
+        with path.open("rb") as stream:  # the magic first: another file is not read whole
             head = stream.read(12)
-        if len(head) < 12 or head[:4] != b"glTF":
-            raise FormatError("not a binary glTF file (no 'glTF' magic)", path)
-        try:
-            self.gltf = pygltflib.GLTF2.load_binary(str(path))
+            if len(head) < 12 or head[:4] != b"glTF":
+                raise FormatError("not a binary glTF file (no 'glTF' magic)", path)
+        json_text, self.blob = self._chunks(memoryview(path.read_bytes()))
+        try:  # pygltflib's typed document; the binary chunk stays a view of the file's bytes
+            self.gltf = pygltflib.GLTF2.from_json(json_text, infer_missing=True)
         except Exception as exc:
             raise FormatError(f"not a valid glTF file: {type(exc).__name__}: {exc}", path) from exc
-        self.path = path
-        self.blob = memoryview(self.gltf.binary_blob() or b"")  # views slice it without a copy
-        if len(self.gltf.nodes) > _MAX_NODES:
+        if len(self.gltf.nodes or ()) > _MAX_NODES:
             raise FormatError(f"{len(self.gltf.nodes)} nodes: more than {_MAX_NODES}", path)
+
+    def _chunks(self, data: memoryview) -> tuple[str, memoryview]:
+        """The JSON text and the binary chunk (empty if none) of the .glb bytes ``data``
+        (glTF 2.0 section 4.4: a 12-byte header, then chunks of a length, a type and the bytes);
+        chunks of other types are skipped, as the specification says."""
+        if len(data) < 12 or bytes(data[:4]) != b"glTF":
+            raise FormatError("not a binary glTF file (no 'glTF' magic)", self.path)
+        version, length = struct.unpack_from("<II", data, 4)
+        if version != 2 or length > len(data):
+            raise FormatError(
+                f"a glTF binary of version {version} and {length} bytes (the file holds "
+                f"{len(data)}): only complete version 2 files are read",
+                self.path,
+            )
+        text: str | None = None
+        blob = memoryview(b"")
+        offset = 12
+        while offset + 8 <= length:
+            size, kind = struct.unpack_from("<II", data, offset)
+            start, offset = offset + 8, offset + 8 + size
+            if offset > length:
+                raise FormatError("a glTF chunk runs past the end of the file", self.path)
+            if kind == _JSON_CHUNK and text is None:
+                try:
+                    text = str(data[start:offset], "utf-8")
+                except UnicodeDecodeError as exc:
+                    raise FormatError(
+                        f"the glTF JSON chunk is not UTF-8: {exc}", self.path
+                    ) from exc
+            elif kind == _BIN_CHUNK and not len(blob):
+                blob = data[start:offset]
+        if text is None:
+            raise FormatError("the glTF file has no JSON chunk", self.path)
+        return text, blob
 
     def view(self, index: int) -> tuple[memoryview, int]:
         """The bytes of buffer view ``index`` and its byte stride (0: tightly packed)."""

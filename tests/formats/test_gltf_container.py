@@ -93,3 +93,47 @@ def test_arrays_written_from_their_own_memory_keep_their_values(tmp_path: Path) 
     assert np.array_equal(got.cell_data["big"].values, big.astype("<i4"))
     assert np.array_equal(got.faces, faces)
     assert np.abs(got.vertices - grid).max() < 1e-3
+
+
+def _glb(
+    version: int = 2, chunks: tuple[tuple[int, bytes], ...] = (), length: int | None = None
+) -> bytes:
+    body = b"".join(struct.pack("<II", len(data), kind) + data for kind, data in chunks)
+    total = 12 + len(body) if length is None else length
+    return struct.pack("<III", 0x46546C67, version, total) + body
+
+
+_JSON, _BIN = 0x4E4F534A, 0x004E4942
+_DOCUMENT = b'{"asset": {"version": "2.0"}}   '
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        (_glb(version=1, chunks=((_JSON, _DOCUMENT),)), "version 1"),
+        (_glb(chunks=((_JSON, _DOCUMENT),), length=4096), "only complete version 2"),
+        (_glb(chunks=((_BIN, b"\0" * 8),)), "no JSON chunk"),
+        (_glb(chunks=((_JSON, b"\xff\xfe{}  "),)), "not UTF-8"),
+        (_glb(chunks=((_JSON, _DOCUMENT),), length=44)[:44], "runs past the end"),
+        (_glb(chunks=((_JSON, b"[1, 2]  "),)), "not a valid glTF"),
+    ],
+)
+def test_a_damaged_container_is_a_format_error_naming_the_file(
+    tmp_path: Path, data: bytes, message: str
+) -> None:
+    from geobrep.errors import FormatError
+
+    path = tmp_path / "damaged.glb"
+    path.write_bytes(data)
+    with pytest.raises(FormatError, match=message) as caught:
+        read(path)
+    assert "damaged.glb" in str(caught.value)
+
+
+def test_chunks_of_unknown_types_are_skipped(tmp_path: Path) -> None:
+    original = write(rich_scene(), tmp_path / "rich.glb").read_bytes()
+    (_, text), (_, blob) = _chunks(original)
+    extra = (0x12345678, b"\1\2\3\4")
+    path = tmp_path / "extra.glb"
+    path.write_bytes(_glb(chunks=((_JSON, text), extra, (_BIN, blob))))
+    assert read(path) == read(tmp_path / "rich.glb")
