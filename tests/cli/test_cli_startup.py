@@ -133,6 +133,21 @@ def test_info_of_a_tsurf_loads_only_what_it_needs() -> None:
     assert not [name for name in built if name.startswith(NOT_BUILT_FOR_INFO)]
 
 
+def test_info_of_a_vtu_reads_it_without_meshio(tmp_path: Path) -> None:
+    """geobrep reads a one-piece VTU itself: meshio (~50 ms to import) is not loaded."""
+    import meshio
+
+    path = tmp_path / "three.vtu"
+    triangle = [("triangle", np.array([[0, 1, 2]]))]
+    meshio.write(path, meshio.Mesh(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), triangle))
+    found = probe("info", str(path))
+    assert found["code"] == 0
+    assert "3 vertices, 1 faces" in str(found["out"])
+    modules = found["modules"]
+    assert "geobrep.adapters.meshio._vtu_reader" in modules
+    assert not loaded(modules, ("meshio", "numpy.ma", "scipy", "pyproj"))
+
+
 def test_lazy_help_is_the_help_of_the_whole_parser(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["--help"]) == 0
     assert capsys.readouterr().out == build_parser().format_help()
