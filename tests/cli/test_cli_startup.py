@@ -210,3 +210,27 @@ def test_a_plugin_operation_is_a_command(
         np.testing.assert_allclose(after.vertices[:, 2], before.vertices[:, 2] + 10.0)
     finally:
         set_host(previous)
+
+
+def test_the_heap_is_frozen_at_exit_after_a_command(tmp_path: Path) -> None:
+    """The interpreter's last garbage collection is skipped (gc.freeze at exit), the output is
+    whole, the written file complete, and exit handlers registered before and after still run."""
+    out = tmp_path / "copy.vtu"
+    code = (
+        "import atexit, gc, sys\n"
+        "atexit.register(lambda: print('frozen', gc.get_freeze_count() > 0))\n"
+        "from geobrep.cli import main\n"
+        "code = main(sys.argv[1:])\n"
+        "atexit.register(lambda: print('later handler ran'))\n"
+        "sys.exit(code)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code, "convert", str(TSURF), str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[-2:] == ["later handler ran", "frozen True"]
+    assert read(out).surfaces[0].n_faces == 2
