@@ -190,6 +190,26 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _run(argv, lines)
 
 
+#: The commands whose run reads or writes through the registries (every one of them loads the
+#: plugin host); ``clean``, ``demo`` and ``run`` are left to load it when they do.
+_HOST_COMMANDS = frozenset(
+    command.name for command in COMMANDS if command.operation or command.name in ("info", "plugins")
+)
+
+
+def _uses_plugins(argv: Sequence[str]) -> bool:
+    """Whether the command line runs a command that loads the plugin host anyway.
+
+    The host is then loaded before the parser, which asks whether plugins add commands
+    (:func:`geobrep.host.only_own_plugins`): the host answers from its plugins, where the
+    question alone scans every installed distribution's entry points (~3.5 ms) and loading
+    the host scans them again. A help request does not load it.
+    """
+    words = [word for word in argv if not word.startswith("-")]
+    asks_help = any(word in ("-h", "--help") for word in argv)
+    return bool(words) and words[0] in _HOST_COMMANDS and not asks_help
+
+
 def _freeze_heap_at_exit() -> None:
     """Have the interpreter skip its last garbage collection when the process ends.
 
@@ -212,6 +232,10 @@ _freezing = False
 
 def _run(argv: Sequence[str] | None, lines: WarningLines) -> int:
     try:  # the chosen command's parser may load the plugins (their operations are commands)
+        if _uses_plugins(sys.argv[1:] if argv is None else argv):
+            from geobrep.host.loader import get_host
+
+            get_host()  # the command needs it: it also tells whether plugins add commands
         args = _lazy_parser()[0].parse_args(argv)
     except SystemExit as exc:  # argparse: --help/--version (0) or a usage error (2)
         return int(exc.code or 0)

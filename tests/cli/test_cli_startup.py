@@ -234,3 +234,33 @@ def test_the_heap_is_frozen_at_exit_after_a_command(tmp_path: Path) -> None:
     lines = done.stdout.splitlines()
     assert lines[-2:] == ["later handler ran", "frozen True"]
     assert read(out).surfaces[0].n_faces == 2
+
+
+def test_info_scans_the_installed_entry_points_once() -> None:
+    """The host, loaded before the parser for a command that uses it, tells whether plugins
+    add commands: the entry points are not scanned a second time for that question."""
+    code = (
+        "import contextlib, io, json, sys\n"
+        "import importlib.metadata as metadata\n"
+        "groups = []\n"
+        "scan = metadata.entry_points\n"
+        "def counted(**params):\n"
+        "    groups.append(params.get('group'))\n"
+        "    return scan(**params)\n"
+        "metadata.entry_points = counted\n"
+        "from geobrep.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()) as out:\n"
+        "    code = main(sys.argv[1:])\n"
+        "print(json.dumps([code, out.getvalue(), groups]))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code, "info", str(TSURF)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    status, out, groups = json.loads(done.stdout.splitlines()[-1])
+    assert status == 0
+    assert "2 faces" in out
+    assert groups.count("geobrep.plugins") == 1
