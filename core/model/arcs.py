@@ -660,7 +660,7 @@ def _exact_rows(points: NDArray[np.float64], queries: NDArray[np.float64]) -> In
     found = np.full(queries.shape[0], -1, dtype=np.int64)
     point_bits = np.ascontiguousarray(points + 0.0).view(np.int64)
     query_bits = np.ascontiguousarray(queries + 0.0).view(np.int64)
-    wanted = np.unique(cell_hash(query_bits))
+    wanted = _sorted_unique(cell_hash(query_bits))
     keys = cell_hash(point_bits)
     at = np.minimum(np.searchsorted(wanted, keys), wanted.shape[0] - 1)
     candidates = np.flatnonzero(wanted[at] == keys)
