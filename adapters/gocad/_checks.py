@@ -53,9 +53,10 @@ def _flat(xyz: NDArray[np.float64], faces: NDArray[np.int64]) -> NDArray[np.bool
     """True for each triangle whose edge cross product is exactly zero (a repeated vertex, or
     three collinear points); NaN from an overflow is not zero area."""
     columns = np.ascontiguousarray(xyz.T)
-    p0 = columns[:, faces[:, 0]]
-    u = columns[:, faces[:, 1]] - p0
-    v = columns[:, faces[:, 2]] - p0
+    # np.take gathers columns several times faster than fancy indexing ``columns[:, ids]``
+    p0 = np.take(columns, faces[:, 0], axis=1)
+    u = np.take(columns, faces[:, 1], axis=1) - p0
+    v = np.take(columns, faces[:, 2], axis=1) - p0
     with np.errstate(over="ignore", invalid="ignore"):
         zero: NDArray[np.bool_] = (u[1] * v[2] - u[2] * v[1]) == 0
         zero &= (u[2] * v[0] - u[0] * v[2]) == 0

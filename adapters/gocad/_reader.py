@@ -184,11 +184,11 @@ class _Builder:
 
             topology = border_topology(surfaces, self.options, self.warn)
         try:
-            scene = Scene(
+            scene = Scene.from_validated(  # the parts are validated models already
                 entities=[*self.entities, *blocks],
                 groups=[*groups, *model_groups],
                 crs=crs,
-                topology=topology if topology is not None else {},
+                topology=topology,
                 name=name,
                 metadata=metadata,
             )
