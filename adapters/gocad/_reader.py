@@ -16,7 +16,7 @@ from __future__ import annotations
 import warnings
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, TypedDict
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
@@ -37,6 +37,9 @@ from geobrep.model.entities import Entity, PointSet, PolyLine, Surface, TetMesh
 from geobrep.model.orientation import orient_blocks
 from geobrep.model.properties import Property
 from geobrep.model.scene import Group, Scene
+
+if TYPE_CHECKING:  # a Model3d read only
+    from geobrep.model.arcs import JoinedPatches
 
 __all__ = ["FLAG_PROPERTY", "GocadReadOptions", "crs_from_block", "read_gocad"]
 
@@ -133,6 +136,7 @@ class _Builder:
         self.path = source.path
         self.entities: list[Entity] = []
         self.scene_crs: CrsBlock | None = None
+        self._scene_crs_model: CRS | None = None
         self.surface_of_object: dict[int, int] = {}
         self.skipped: list[str] = []
 
@@ -155,9 +159,10 @@ class _Builder:
             group = self.add_object(obj, None, models)
             if group is not None:
                 groups.append(group)
-        crs = crs_from_block(self.scene_crs) if self.scene_crs is not None else None
+        crs = self._scene_crs() if self.scene_crs is not None else None
         surfaces = [e for e in self.entities if isinstance(e, Surface)]
         topology = None
+        joined: JoinedPatches | None = None
         blocks: list[Entity] = []
         model_groups: list[Group] = []
         name = objects[0].name
@@ -174,7 +179,7 @@ class _Builder:
             name = model.name
             self._kinds_from_model(model)
             surfaces = [e for e in self.entities if isinstance(e, Surface)]
-            topology, blocks, model_groups, metadata, surfaces = attach_model3d(
+            topology, blocks, model_groups, metadata, surfaces, joined = attach_model3d(
                 model, surfaces, self.next_id(), self._z_sign(model), self.options, self
             )
             by_id = {int(s.id or 0): s for s in surfaces}
@@ -195,13 +200,20 @@ class _Builder:
         except (EntityValidationError, TopologyError) as exc:
             raise self.error(f"the file's objects do not form a valid scene: {exc}", None) from exc
         if blocks and self.options.repair:
-            scene = self._orient_blocks(scene)
+            scene = self._orient_blocks(scene, joined)
         return scene
 
-    def _orient_blocks(self, scene: Scene) -> Scene:
+    def _scene_crs(self) -> CRS:
+        """The CRS of :attr:`scene_crs` (made once)."""
+        assert self.scene_crs is not None
+        if self._scene_crs_model is None:
+            self._scene_crs_model = crs_from_block(self.scene_crs)
+        return self._scene_crs_model
+
+    def _orient_blocks(self, scene: Scene, joined: JoinedPatches | None) -> Scene:
         """REGION sides reversed where the geometry contradicts them (one warning each)."""
         try:
-            scene, notes = orient_blocks(scene)
+            scene, notes = orient_blocks(scene, joined)
         except TopologyError as exc:
             raise self.error(
                 f"{exc} (read with repair=False to load the model as written)", None
@@ -273,7 +285,9 @@ class _Builder:
             obj.crs is not None
             and not obj.inherited_crs
             and (
-                self.scene_crs is None or crs_from_block(obj.crs) != crs_from_block(self.scene_crs)
+                self.scene_crs is None
+                # equal blocks (text only) make equal CRSs: built only when they differ
+                or (obj.crs != self.scene_crs and crs_from_block(obj.crs) != self._scene_crs())
             )
         ):
             meta["crs"] = obj.crs

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -42,7 +43,10 @@ from geobrep.model._shells import (
     patch_triangles,
 )
 from geobrep.model.entities import Block, PatchSide, Surface
-from geobrep.model.scene import Scene
+from geobrep.model.scene import RELATIVE_MERGE_TOLERANCE, Scene
+
+if TYPE_CHECKING:
+    from geobrep.model.arcs import JoinedPatches
 
 __all__ = ["BlockOrientation", "block_orientations", "orient_blocks", "orient_patches"]
 
@@ -193,14 +197,19 @@ def _decide(
     return BlockOrientation(block, tuple(new_sides), tuple(reversed_patches), volume, open_edges)
 
 
-def block_orientations(scene: Scene, exact_volumes: bool = True) -> list[BlockOrientation]:
+def block_orientations(
+    scene: Scene, exact_volumes: bool = True, joined: JoinedPatches | None = None
+) -> list[BlockOrientation]:
     """How each block of ``scene`` (the universe included) must list its sides.
 
     ``exact_volumes=False``: a closed block whose shell runs one way and whose sides stand
     (the usual block) is decided from the volumes of its patches about one origin when they
     leave the sign of its volume beyond doubt; its ``volume`` is then that sum, which may
     differ from the volume of its shell in the last bits. Every other block is measured as
-    with ``True``.
+    with ``True``. ``joined`` (with ``exact_volumes=False``): the scene's patches joined as
+    :func:`~geobrep.model.arcs.corners_and_arcs_of` joined them; when every block is such a
+    block on that mesh and it is the mesh the scene's own tolerance gives, the blocks are
+    decided on it.
     """
     blocks = [
         block
@@ -209,6 +218,10 @@ def block_orientations(scene: Scene, exact_volumes: bool = True) -> list[BlockOr
     ]
     if not blocks:
         return []
+    if joined is not None and not exact_volumes:
+        on_joined = _standing_on_joined(scene, blocks, joined)
+        if on_joined is not None:
+            return on_joined
     points, triangles_of = patch_triangles(scene, blocks)
     edges = patch_edges(triangles_of, int(points.shape[0]))
     areas, volumes = _patch_measures(points, triangles_of, with_volumes=not exact_volumes)
@@ -273,6 +286,51 @@ def _patch_measures(
     )
 
 
+def _standing_on_joined(
+    scene: Scene, blocks: list[Block], joined: JoinedPatches
+) -> list[BlockOrientation] | None:
+    """Every block's :func:`_standing_orientation` on the ``joined`` mesh, or None when a
+    block is no standing one there or the mesh may not be the one :func:`patch_triangles`
+    joins: that one joins the points within the scene's tolerance, which is no larger than
+    ``joined.tolerance``, so when ``joined`` only joined copies of one point the two join the
+    same vertices and drop the same triangles (the patches the same surfaces' labels)."""
+    box = scene.bounds
+    tolerance = RELATIVE_MERGE_TOLERANCE * (box.diagonal if box else 1.0)
+    if not (joined.exact and tolerance <= joined.tolerance):
+        return None
+    position = {p.id: k for k, p in enumerate(joined.patches)}
+    surfaces = {scene.topology.patch(s.patch).surface for b in blocks for s in b.sides}
+    bounds = np.searchsorted(joined.owners, np.arange(len(joined.patches) + 1)).tolist()
+    triangles_of: dict[int, IntArray] = {}
+    for patch in scene.topology.patches:  # the patches patch_triangles gives triangles to
+        if patch.surface not in surfaces:
+            continue
+        k = position.get(patch.id)
+        if k is None:
+            return None
+        listed = joined.patches[k]
+        if (listed.surface, listed.label) != (patch.surface, patch.label) or (
+            joined.surfaces[k] is not scene.get(patch.surface)
+        ):
+            return None
+        triangles_of[patch.id] = joined.triangles[bounds[k] : bounds[k + 1]]
+    edges = patch_edges(triangles_of, int(joined.points.shape[0]))
+    _, volumes = _patch_measures(joined.points, triangles_of, with_volumes=True)
+    if edges is None or volumes is None:
+        return None
+    out = []
+    for block in blocks:
+        if any(side.patch not in triangles_of for side in block.sides):
+            return None
+        if open_edges_if_one_way(edges, block) != 0:
+            return None
+        standing = _standing_orientation(block, volumes)
+        if standing is None:
+            return None
+        out.append(standing)
+    return out
+
+
 def _patch_areas(points: FloatArray, triangles_of: dict[int, IntArray]) -> dict[int, FloatArray]:
     """The area of every triangle of every patch (one pass over all of them)."""
     return _patch_measures(points, triangles_of, with_volumes=False)[0]
@@ -323,13 +381,15 @@ def _one_way_orientation(
     return _decide(block, np.zeros(len(boundary), dtype=np.bool_), volume, area, open_edges)
 
 
-def orient_blocks(scene: Scene) -> tuple[Scene, list[str]]:
+def orient_blocks(scene: Scene, joined: JoinedPatches | None = None) -> tuple[Scene, list[str]]:
     """``scene`` with every block's sides orienting its boundary outward; one note per repair.
 
     Blocks enclose positive volume and the universe negative volume afterwards; patches record
     their new positive and negative blocks. A block that cannot be oriented is a TopologyError.
+    ``joined``: the patches as a reader joined them to find the corners and arcs (see
+    :func:`block_orientations`), for the usual model's blocks to be checked on that mesh.
     """
-    orientations = block_orientations(scene, exact_volumes=False)
+    orientations = block_orientations(scene, exact_volumes=False, joined=joined)
     notes: list[str] = []
     changed = {int(o.block.id or 0): o for o in orientations if o.changed}
     for item in orientations:

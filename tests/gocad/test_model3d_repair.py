@@ -18,6 +18,7 @@ from gocad_files import DATA
 import geobrep
 from geobrep import Block, PatchSide, Scene, Surface, TopologyError
 from geobrep.geometry.mesh import flip_faces, is_consistently_oriented
+from geobrep.model.arcs import JoinedPatches, corners_and_arcs_of
 from geobrep.model.orientation import block_orientations, orient_blocks
 
 MODELS = sorted(p.name for p in DATA.glob("*.ml"))
@@ -195,3 +196,38 @@ def test_a_closed_block_whose_sides_stand_is_decided_by_its_patch_volumes() -> N
             assert not found.changed
         else:  # inside out: left to the whole rule, which reverses the side
             assert found is None
+
+
+def _joined(scene: Scene, tolerance: float) -> JoinedPatches:
+    surfaces = {int(s.id or 0): s for s in scene.surfaces}
+    joined = corners_and_arcs_of(surfaces, scene.topology.patches, tolerance)[3]
+    assert joined is not None
+    return joined
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_blocks_checked_on_the_mesh_of_the_arcs_are_those_of_their_own_mesh(name: str) -> None:
+    from geobrep.model.orientation import _standing_on_joined
+
+    scene, _ = _read(DATA / name, repair=False)
+    box = scene.bounds
+    assert box is not None
+    joined = _joined(scene, 1e-8 * box.diagonal)  # the reader's default
+    try:
+        alone = block_orientations(scene, exact_volumes=False)
+    except TopologyError:
+        with pytest.raises(TopologyError):
+            block_orientations(scene, exact_volumes=False, joined=joined)
+        return
+    on_joined = block_orientations(scene, exact_volumes=False, joined=joined)
+    assert [(o.block.id, o.sides, o.reversed_patches, o.open_edges) for o in on_joined] == [
+        (o.block.id, o.sides, o.reversed_patches, o.open_edges) for o in alone
+    ]
+    assert [o.volume for o in on_joined] == pytest.approx([o.volume for o in alone], rel=1e-9)
+    blocks = list(scene.of_type(Block))
+    if name in ("modelA1.ml", "modelA4.ml"):  # closed, standing blocks: decided on the mesh
+        assert _standing_on_joined(scene, blocks, joined) is not None
+    # a mesh joined more finely than the scene's tolerance, or joining different points,
+    # may not be the scene's own: not used
+    assert _standing_on_joined(scene, blocks, _joined(scene, 1e-12 * box.diagonal)) is None
+    assert _standing_on_joined(scene, blocks, joined._replace(exact=False)) is None
