@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypedDict
@@ -137,6 +138,9 @@ class _Builder:
         self.entities: list[Entity] = []
         self.scene_crs: CrsBlock | None = None
         self._scene_crs_model: CRS | None = None
+        self._tface_types: dict[str, str] = {}
+        """TSurf name -> the type of its first header TFACE in the Model3d (see
+        :meth:`_kinds_from_model`), for TSurfs to take when they are made."""
         self.surface_of_object: dict[int, int] = {}
         self.skipped: list[str] = []
 
@@ -153,6 +157,7 @@ class _Builder:
     # -- the whole file -----------------------------------------------------------------------
     def build(self, objects: list[GocadObject]) -> Scene:
         self.scene_crs = _first_crs(objects)
+        self._tface_types = _tface_types(objects)
         groups: list[Group] = []
         models: list[GocadObject] = []
         for obj in objects:
@@ -357,6 +362,15 @@ class _Builder:
         cell_data = _properties(obj.cell_header, values, obj.class_headers, where, self.error)
         names = tuple(name or str(i) for i, name in enumerate(obj.part_names))
         if obj.type == "TSurf":
+            if fields["kind"] is None and self._tface_types:  # as _kinds_from_model gives it
+                called = [obj.name]
+                for key, value in obj.header:
+                    if key == "name_in_model_list":
+                        called.insert(0, str(value))
+                types = self._tface_types
+                found = next((types[n] for n in called if n in types), None)
+                if found is not None:
+                    fields["kind"] = kind_of(found)
             self._warn_empty_tfaces(obj, parts)
             self._warn_bad_triangles(obj, xyz, index, lines)
             self._hints(obj, lookup, fields)
@@ -753,6 +767,28 @@ def _ctetra_codes(
                 surfaces.append(body)
             codes[cell, k] = sign * (position[body] + 1)
     return codes, surfaces, regions
+
+
+def _model3d_objects(objects: list[GocadObject]) -> Iterator[GocadObject]:
+    """The Model3d objects in the order :meth:`_Builder.add_object` meets them."""
+    for obj in objects:
+        if obj.type in GROUP_TYPES:
+            yield from _model3d_objects(obj.members)
+        elif obj.type == "Model3d":
+            yield obj
+
+
+def _tface_types(objects: list[GocadObject]) -> dict[str, str]:
+    """TSurf name -> the type of its first header TFACE, in the Model3d that defines the
+    topology (:meth:`_Builder.build`); empty without one."""
+    models = list(_model3d_objects(objects))
+    if not models:
+        return {}
+    model = next((m for m in models if m.model3d.tfaces), models[0])
+    types: dict[str, str] = {}
+    for entry in model.model3d.tfaces:
+        types.setdefault(entry.tsurf, entry.type)
+    return types
 
 
 def _first_crs(objects: list[GocadObject]) -> CrsBlock | None:

@@ -254,18 +254,22 @@ class _PatchVolumes:
 
 
 def _patch_measures(
-    points: FloatArray, triangles_of: dict[int, IntArray], with_volumes: bool
+    points: FloatArray,
+    triangles_of: dict[int, IntArray],
+    with_volumes: bool,
+    with_areas: bool = True,
 ) -> tuple[dict[int, FloatArray], _PatchVolumes | None]:
-    """The area of every triangle of every patch (one pass over all of them) and, with
-    ``with_volumes``, their :class:`_PatchVolumes`."""
+    """The area of every triangle of every patch (one pass over all of them; none without
+    ``with_areas``) and, with ``with_volumes``, their :class:`_PatchVolumes`."""
     ids = list(triangles_of)
     if not ids:
         return {}, None
     counts = np.array([triangles_of[i].shape[0] for i in ids], dtype=np.int64)
     triangles = np.concatenate([triangles_of[i] for i in ids])
-    areas = mesh.face_areas(points, triangles)
     cuts = np.cumsum(counts)[:-1]
-    by_patch = dict(zip(ids, np.split(areas, cuts), strict=True))
+    by_patch: dict[int, FloatArray] = {}
+    if with_areas:
+        by_patch = dict(zip(ids, np.split(mesh.face_areas(points, triangles), cuts), strict=True))
     if not with_volumes or not points.size:
         return by_patch, None
     low, high = column_extremes(points)
@@ -315,7 +319,7 @@ def _standing_on_joined(
             return None
         triangles_of[patch.id] = joined.triangles[bounds[k] : bounds[k + 1]]
     edges = patch_edges(triangles_of, int(joined.points.shape[0]))
-    _, volumes = _patch_measures(joined.points, triangles_of, with_volumes=True)
+    _, volumes = _patch_measures(joined.points, triangles_of, with_volumes=True, with_areas=False)
     if edges is None or volumes is None:
         return None
     out = []
