@@ -645,3 +645,53 @@ class TestCrsInput:
     def test_bad_values_are_named(self, value: Any, message: str) -> None:
         with pytest.raises(geobrep.GeobrepError, match=re.escape(message)):
             Scene(crs=value)
+
+
+# ----------------------------------------------------------------------------- validated parts
+class TestFromValidated:
+    """``Scene.from_validated`` (the readers' constructor) gives what ``Scene(...)`` gives."""
+
+    @staticmethod
+    def _parts(scene: Scene) -> dict[str, Any]:
+        return {name: getattr(scene, name) for name in Scene.model_fields}
+
+    def test_the_same_scene_as_the_constructor(self) -> None:
+        cake = geobrep.datasets.faulted_layer_cake()
+        parts = self._parts(cake)
+        parts["metadata"] = {"source": {"file": "cake", "rows": [1, 2.5, None]}}
+        built, assembled = Scene(**parts), Scene.from_validated(**parts)
+        assert assembled == built
+        assert assembled.model_fields_set == built.model_fields_set
+        assert all(a is b for a, b in zip(assembled.entities, built.entities, strict=True))
+        assert assembled.metadata == built.metadata
+        assert assembled.metadata is not parts["metadata"]  # validated, as the field is
+
+    def test_ids_are_given_as_the_constructor_gives_them(self) -> None:
+        scene = Scene.from_validated(entities=[wells(name="a"), wells(name="b", id=7)])
+        assert [e.id for e in scene.entities] == [8, 7]
+
+    def test_references_are_checked(self) -> None:
+        with pytest.raises(EntityValidationError, match="entity id 1 is used twice"):
+            Scene.from_validated(entities=[wells(id=1), wells(name="b", id=1)])
+        patch = Patch(id=0, surface=0, label=0)
+        with pytest.raises(TopologyError, match="entity 0 is not a Surface"):
+            Scene.from_validated(entities=[wells(id=0)], topology=Topology(patches=(patch,)))
+
+    def test_metadata_is_validated_as_the_field_is(self) -> None:
+        with pytest.raises(EntityValidationError) as info:
+            Scene.from_validated(entities=[wells()], metadata={"bad": object()})
+        with pytest.raises(EntityValidationError) as expected:
+            Scene(entities=[wells()], metadata={"bad": object()})
+        assert (info.value.entity, info.value.field) == (
+            expected.value.entity,
+            expected.value.field,
+        )
+        assert str(info.value) == str(expected.value)
+
+    def test_parts_that_are_no_models_go_through_the_constructor(self) -> None:
+        scene = Scene.from_validated(
+            entities=[wells()],
+            topology={"patches": []},  # type: ignore[arg-type]
+            crs="EPSG:32633",  # type: ignore[arg-type]
+        )
+        assert scene == Scene(entities=[wells()], topology={"patches": []}, crs="EPSG:32633")

@@ -30,7 +30,7 @@ from geobrep.adapters.gocad._records import (
 )
 from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.geometry.bbox import column_extremes
-from geobrep.model.arcs import corners_and_arcs
+from geobrep.model.arcs import JoinedPatches, corners_and_arcs_of
 from geobrep.model.entities import UNIVERSE_KIND, Block, Entity, PatchSide, Surface
 from geobrep.model.orientation import orient_patches
 from geobrep.model.scene import Group
@@ -56,6 +56,7 @@ class Model3dParts(NamedTuple):
     groups: list[Group]
     metadata: dict[str, Any]  # the scene's metadata["gocad"]["model3d"]
     surfaces: list[Surface]  # the member surfaces (turned to agree with their key triangles)
+    joined: JoinedPatches | None  # the mesh the corners and arcs were found on
 
 
 def find_key_triangle(
@@ -76,13 +77,16 @@ def _match_key(
     vertices: NDArray[np.float64],
     key: NDArray[np.float64],
     tolerance: float,
+    first: NDArray[np.float64] | None = None,
 ) -> tuple[int | None, bool]:
     """:func:`find_key_triangle` among ``faces`` (their first three vertices ``corners``): a
     corner matches a key point when each coordinate is within ``tolerance``; the faces whose
-    first corner matches are found first, and only those are checked whole."""
+    first corner matches are found first, and only those are checked whole. ``first``: the
+    coordinates of the faces' first corners as columns (3, M), when known."""
     if faces.size == 0:
         return None, False
-    first = vertices[corners[:, 0]]
+    if first is None:
+        first = np.ascontiguousarray(vertices[corners[:, 0]].T)
     near_first: dict[int, NDArray[np.int64]] = {}
     for reverse in (False, True):
         for shift in range(3):
@@ -91,8 +95,7 @@ def _match_key(
             if reverse:
                 which = [2 - w for w in which]
             if which[0] not in near_first:
-                close = (np.abs(first - key[which[0]]) <= tolerance).all(axis=1)
-                near_first[which[0]] = np.flatnonzero(close)
+                near_first[which[0]] = np.flatnonzero(_near(first, key[which[0]], tolerance))
             hit = near_first[which[0]]
             for j in (1, 2):
                 if not hit.size:
@@ -102,6 +105,17 @@ def _match_key(
             if hit.size:
                 return int(faces[hit[0]]), reverse
     return None, False
+
+
+def _near(
+    columns: NDArray[np.float64], point: NDArray[np.float64], tolerance: float
+) -> NDArray[np.bool_]:
+    """Which of the points ``columns`` (3, M) lie within ``tolerance`` of ``point`` in each
+    coordinate (a column at a time: a reduction across the rows of (M, 3) is slow)."""
+    close: NDArray[np.bool_] = np.abs(columns[0] - point[0]) <= tolerance
+    close &= np.abs(columns[1] - point[1]) <= tolerance
+    close &= np.abs(columns[2] - point[2]) <= tolerance
+    return close
 
 
 class _PatchCorners:
@@ -117,13 +131,21 @@ class _PatchCorners:
         self.order = np.argsort(labels, kind="stable").astype(np.int64)
         self.bounds = np.searchsorted(labels[self.order], np.arange(surface.n_patches + 1))
         self.corners = surface.faces[self.order][:, :3]
+        self.first = np.take(np.ascontiguousarray(surface.vertices.T), self.corners[:, 0], axis=1)
 
     def find(
         self, label: int, key: NDArray[np.float64], tolerance: float
     ) -> tuple[int | None, bool]:
         """:func:`find_key_triangle` of patch ``label``."""
         lo, hi = int(self.bounds[label]), int(self.bounds[label + 1])
-        return _match_key(self.order[lo:hi], self.corners[lo:hi], self.vertices, key, tolerance)
+        return _match_key(
+            self.order[lo:hi],
+            self.corners[lo:hi],
+            self.vertices,
+            key,
+            tolerance,
+            self.first[:, lo:hi],
+        )
 
 
 def _tsurf_names(surface: Surface) -> list[str]:
@@ -156,10 +178,10 @@ def attach_model3d(
     blocks, region_block = _region_blocks(header, matched, first_id, builder)
     sides = _with_blocks(matched.patches, blocks)
     groups = _groups(header.lists, region_block, matched.patches, builder)
-    topology = _rebuilt_topology(
+    topology, joined = _rebuilt_topology(
         surfaces, matched.patches, options.merge_tolerance_for(diagonal), builder.warn, sides
     )
-    return Model3dParts(topology, blocks, groups, _model_metadata(model), surfaces)
+    return Model3dParts(topology, blocks, groups, _model_metadata(model), surfaces, joined)
 
 
 def _diagonal(surfaces: Sequence[Surface]) -> float:
@@ -358,15 +380,16 @@ def _rebuilt_topology(
     tolerance: float,
     warn: Callable[[str], None] | None,
     updates: dict[int, dict[str, Any]] | None = None,
-) -> Topology:
+) -> tuple[Topology, JoinedPatches | None]:
     """Corners and arcs rebuilt from the patches (BSTONEs as extra corners) around them; each
-    patch is copied once, with its arcs and its ``updates`` (the blocks on its sides)."""
-    corners, arcs, patch_arcs = corners_and_arcs(
+    patch is copied once, with its arcs and its ``updates`` (the blocks on its sides); and
+    the joined mesh they were found on."""
+    corners, arcs, patch_arcs, joined = corners_and_arcs_of(
         {int(s.id or 0): s for s in surfaces}, patches, tolerance, _bstone_points(surfaces)
     )
     if warn is not None:
         warn_idle_bstones(surfaces, corners, tolerance, warn)
-    return Topology(
+    topology = Topology(
         corners=tuple(corners),
         arcs=tuple(arcs),
         patches=tuple(
@@ -376,6 +399,7 @@ def _rebuilt_topology(
             for p in patches
         ),
     )
+    return topology, joined
 
 
 def _model_metadata(model: GocadObject) -> dict[str, Any]:
@@ -504,4 +528,4 @@ def border_topology(
     ]
     points = np.concatenate([s.vertices for s in surfaces if s.n_vertices] or [np.zeros((1, 3))])
     diagonal = _box_diagonal(points)
-    return _rebuilt_topology(surfaces, patches, options.merge_tolerance_for(diagonal), warn)
+    return _rebuilt_topology(surfaces, patches, options.merge_tolerance_for(diagonal), warn)[0]

@@ -14,9 +14,10 @@
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, TypedDict
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
@@ -37,6 +38,9 @@ from geobrep.model.entities import Entity, PointSet, PolyLine, Surface, TetMesh
 from geobrep.model.orientation import orient_blocks
 from geobrep.model.properties import Property
 from geobrep.model.scene import Group, Scene
+
+if TYPE_CHECKING:  # a Model3d read only
+    from geobrep.model.arcs import JoinedPatches
 
 __all__ = ["FLAG_PROPERTY", "GocadReadOptions", "crs_from_block", "read_gocad"]
 
@@ -133,6 +137,10 @@ class _Builder:
         self.path = source.path
         self.entities: list[Entity] = []
         self.scene_crs: CrsBlock | None = None
+        self._scene_crs_model: CRS | None = None
+        self._tface_types: dict[str, str] = {}
+        """TSurf name -> the type of its first header TFACE in the Model3d (see
+        :meth:`_kinds_from_model`), for TSurfs to take when they are made."""
         self.surface_of_object: dict[int, int] = {}
         self.skipped: list[str] = []
 
@@ -149,15 +157,17 @@ class _Builder:
     # -- the whole file -----------------------------------------------------------------------
     def build(self, objects: list[GocadObject]) -> Scene:
         self.scene_crs = _first_crs(objects)
+        self._tface_types = _tface_types(objects)
         groups: list[Group] = []
         models: list[GocadObject] = []
         for obj in objects:
             group = self.add_object(obj, None, models)
             if group is not None:
                 groups.append(group)
-        crs = crs_from_block(self.scene_crs) if self.scene_crs is not None else None
+        crs = self._scene_crs() if self.scene_crs is not None else None
         surfaces = [e for e in self.entities if isinstance(e, Surface)]
         topology = None
+        joined: JoinedPatches | None = None
         blocks: list[Entity] = []
         model_groups: list[Group] = []
         name = objects[0].name
@@ -174,7 +184,7 @@ class _Builder:
             name = model.name
             self._kinds_from_model(model)
             surfaces = [e for e in self.entities if isinstance(e, Surface)]
-            topology, blocks, model_groups, metadata, surfaces = attach_model3d(
+            topology, blocks, model_groups, metadata, surfaces, joined = attach_model3d(
                 model, surfaces, self.next_id(), self._z_sign(model), self.options, self
             )
             by_id = {int(s.id or 0): s for s in surfaces}
@@ -184,24 +194,31 @@ class _Builder:
 
             topology = border_topology(surfaces, self.options, self.warn)
         try:
-            scene = Scene(
+            scene = Scene.from_validated(  # the parts are validated models already
                 entities=[*self.entities, *blocks],
                 groups=[*groups, *model_groups],
                 crs=crs,
-                topology=topology if topology is not None else {},
+                topology=topology,
                 name=name,
                 metadata=metadata,
             )
         except (EntityValidationError, TopologyError) as exc:
             raise self.error(f"the file's objects do not form a valid scene: {exc}", None) from exc
         if blocks and self.options.repair:
-            scene = self._orient_blocks(scene)
+            scene = self._orient_blocks(scene, joined)
         return scene
 
-    def _orient_blocks(self, scene: Scene) -> Scene:
+    def _scene_crs(self) -> CRS:
+        """The CRS of :attr:`scene_crs` (made once)."""
+        assert self.scene_crs is not None
+        if self._scene_crs_model is None:
+            self._scene_crs_model = crs_from_block(self.scene_crs)
+        return self._scene_crs_model
+
+    def _orient_blocks(self, scene: Scene, joined: JoinedPatches | None) -> Scene:
         """REGION sides reversed where the geometry contradicts them (one warning each)."""
         try:
-            scene, notes = orient_blocks(scene)
+            scene, notes = orient_blocks(scene, joined)
         except TopologyError as exc:
             raise self.error(
                 f"{exc} (read with repair=False to load the model as written)", None
@@ -273,7 +290,9 @@ class _Builder:
             obj.crs is not None
             and not obj.inherited_crs
             and (
-                self.scene_crs is None or crs_from_block(obj.crs) != crs_from_block(self.scene_crs)
+                self.scene_crs is None
+                # equal blocks (text only) make equal CRSs: built only when they differ
+                or (obj.crs != self.scene_crs and crs_from_block(obj.crs) != self._scene_crs())
             )
         ):
             meta["crs"] = obj.crs
@@ -343,6 +362,15 @@ class _Builder:
         cell_data = _properties(obj.cell_header, values, obj.class_headers, where, self.error)
         names = tuple(name or str(i) for i, name in enumerate(obj.part_names))
         if obj.type == "TSurf":
+            if fields["kind"] is None and self._tface_types:  # as _kinds_from_model gives it
+                called = [obj.name]
+                for key, value in obj.header:
+                    if key == "name_in_model_list":
+                        called.insert(0, str(value))
+                types = self._tface_types
+                found = next((types[n] for n in called if n in types), None)
+                if found is not None:
+                    fields["kind"] = kind_of(found)
             self._warn_empty_tfaces(obj, parts)
             self._warn_bad_triangles(obj, xyz, index, lines)
             self._hints(obj, lookup, fields)
@@ -739,6 +767,28 @@ def _ctetra_codes(
                 surfaces.append(body)
             codes[cell, k] = sign * (position[body] + 1)
     return codes, surfaces, regions
+
+
+def _model3d_objects(objects: list[GocadObject]) -> Iterator[GocadObject]:
+    """The Model3d objects in the order :meth:`_Builder.add_object` meets them."""
+    for obj in objects:
+        if obj.type in GROUP_TYPES:
+            yield from _model3d_objects(obj.members)
+        elif obj.type == "Model3d":
+            yield obj
+
+
+def _tface_types(objects: list[GocadObject]) -> dict[str, str]:
+    """TSurf name -> the type of its first header TFACE, in the Model3d that defines the
+    topology (:meth:`_Builder.build`); empty without one."""
+    models = list(_model3d_objects(objects))
+    if not models:
+        return {}
+    model = next((m for m in models if m.model3d.tfaces), models[0])
+    types: dict[str, str] = {}
+    for entry in model.model3d.tfaces:
+        types.setdefault(entry.tsurf, entry.type)
+    return types
 
 
 def _first_crs(objects: list[GocadObject]) -> CrsBlock | None:

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -59,9 +60,11 @@ from geobrep.model.topology import Arc, Corner, Patch, Topology
 __all__ = [
     "DEFAULT_RELATIVE_TOLERANCE",
     "ArcChains",
+    "JoinedPatches",
     "build_corners_and_arcs",
     "chain_arc_edges",
     "corners_and_arcs",
+    "corners_and_arcs_of",
 ]
 
 #: Default joining distance, relative to the diagonal of the patches' bounding box.
@@ -102,6 +105,26 @@ class ArcChains:
         return np.repeat(np.arange(self.n_arcs, dtype=np.int64), np.diff(self.arc_offsets)).astype(
             np.int64
         )
+
+
+class JoinedPatches(NamedTuple):
+    """The patches' triangles once coincident vertices are joined, as
+    :func:`corners_and_arcs_of` builds the corners and arcs on them (for a reader that goes on
+    to check the blocks on the same mesh, see :func:`geobrep.model.orientation.orient_blocks`).
+
+    ``triangles`` use the ``points`` (joined vertices), triangles the joining collapsed left
+    out; ``owners`` (ascending) is the position in ``patches`` of each triangle's patch and
+    ``surfaces`` the surface of each patch. ``exact``: every joined point stands for copies of
+    one point only (no two different points were joined).
+    """
+
+    points: NDArray[np.float64]
+    triangles: IntArray
+    owners: IntArray
+    patches: tuple[Patch, ...]
+    surfaces: tuple[Surface, ...]
+    tolerance: float
+    exact: bool
 
 
 def _segments(offsets: IntArray, rows: IntArray) -> tuple[IntArray, IntArray]:
@@ -660,7 +683,7 @@ def _exact_rows(points: NDArray[np.float64], queries: NDArray[np.float64]) -> In
     found = np.full(queries.shape[0], -1, dtype=np.int64)
     point_bits = np.ascontiguousarray(points + 0.0).view(np.int64)
     query_bits = np.ascontiguousarray(queries + 0.0).view(np.int64)
-    wanted = np.unique(cell_hash(query_bits))
+    wanted = _sorted_unique(cell_hash(query_bits))
     keys = cell_hash(point_bits)
     at = np.minimum(np.searchsorted(wanted, keys), wanted.shape[0] - 1)
     candidates = np.flatnonzero(wanted[at] == keys)
@@ -706,9 +729,21 @@ def corners_and_arcs(
     arc's first edge (a patch on both sides twice) in right-hand order about that edge (see
     :func:`geobrep.geometry.sort_around_axis`), as :class:`~geobrep.model.topology.Arc` asks.
     """
+    corners, arcs, patch_arcs, _ = corners_and_arcs_of(surfaces, patches, tolerance, extra_corners)
+    return corners, arcs, patch_arcs
+
+
+def corners_and_arcs_of(
+    surfaces: Mapping[int, Surface],
+    patches: Sequence[Patch],
+    tolerance: float | None = None,
+    extra_corners: ArrayLike | None = None,
+) -> tuple[list[Corner], list[Arc], dict[int, list[int]], JoinedPatches | None]:
+    """:func:`corners_and_arcs` and the :class:`JoinedPatches` they are built on (None when
+    the patches have no triangles)."""
     vertices, triangles, owners = _patch_triangles(surfaces, patches)
     if triangles.shape[0] == 0:
-        return [], [], {}
+        return [], [], {}, None
     used, compact = mesh.compact_indices(triangles, vertices.shape[0])
     points = vertices[used]
     if tolerance is None:
@@ -720,8 +755,17 @@ def corners_and_arcs(
     proper = (tri[:, 0] != tri[:, 1]) & (tri[:, 1] != tri[:, 2]) & (tri[:, 0] != tri[:, 2])
     tri, owners = tri[proper], owners[proper]
     if tri.shape[0] == 0:
-        return [], [], {}
+        return [], [], {}, None
     n_vertices = merged.shape[0]
+    joined = JoinedPatches(
+        points=merged,
+        triangles=tri,
+        owners=owners,
+        patches=tuple(patches),
+        surfaces=tuple(surfaces[p.surface] for p in patches),
+        tolerance=float(tolerance),
+        exact=bool(np.array_equal(points, np.take(merged, inverse, axis=0))),
+    )
 
     edges, offsets, incident, sides = mesh.edge_face_incidence(tri)
     incident_patch = owners[incident]
@@ -763,4 +807,4 @@ def corners_and_arcs(
         )
         for patch_id in dict.fromkeys(patch_ids):
             patch_arcs.setdefault(patch_id, []).append(a)
-    return corners, arcs, patch_arcs
+    return corners, arcs, patch_arcs, joined

@@ -26,12 +26,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from geobrep.errors import TopologyError
 from geobrep.geometry import mesh
 from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
+from geobrep.geometry.bbox import column_extremes
 from geobrep.geometry.orientation import orientation_flips
 from geobrep.model._shells import (
     Shell,
@@ -41,7 +43,10 @@ from geobrep.model._shells import (
     patch_triangles,
 )
 from geobrep.model.entities import Block, PatchSide, Surface
-from geobrep.model.scene import Scene
+from geobrep.model.scene import RELATIVE_MERGE_TOLERANCE, Scene
+
+if TYPE_CHECKING:
+    from geobrep.model.arcs import JoinedPatches
 
 __all__ = ["BlockOrientation", "block_orientations", "orient_blocks", "orient_patches"]
 
@@ -192,8 +197,20 @@ def _decide(
     return BlockOrientation(block, tuple(new_sides), tuple(reversed_patches), volume, open_edges)
 
 
-def block_orientations(scene: Scene) -> list[BlockOrientation]:
-    """How each block of ``scene`` (the universe included) must list its sides."""
+def block_orientations(
+    scene: Scene, exact_volumes: bool = True, joined: JoinedPatches | None = None
+) -> list[BlockOrientation]:
+    """How each block of ``scene`` (the universe included) must list its sides.
+
+    ``exact_volumes=False``: a closed block whose shell runs one way and whose sides stand
+    (the usual block) is decided from the volumes of its patches about one origin when they
+    leave the sign of its volume beyond doubt; its ``volume`` is then that sum, which may
+    differ from the volume of its shell in the last bits. Every other block is measured as
+    with ``True``. ``joined`` (with ``exact_volumes=False``): the scene's patches joined as
+    :func:`~geobrep.model.arcs.corners_and_arcs_of` joined them; when every block is such a
+    block on that mesh and it is the mesh the scene's own tolerance gives, the blocks are
+    decided on it.
+    """
     blocks = [
         block
         for block in scene.of_type(Block)
@@ -201,12 +218,21 @@ def block_orientations(scene: Scene) -> list[BlockOrientation]:
     ]
     if not blocks:
         return []
+    if joined is not None and not exact_volumes:
+        on_joined = _standing_on_joined(scene, blocks, joined)
+        if on_joined is not None:
+            return on_joined
     points, triangles_of = patch_triangles(scene, blocks)
     edges = patch_edges(triangles_of, int(points.shape[0]))
-    areas = _patch_areas(points, triangles_of)
+    areas, volumes = _patch_measures(points, triangles_of, with_volumes=not exact_volumes)
     out = []
     for block in blocks:
         open_edges = None if edges is None else open_edges_if_one_way(edges, block)
+        if open_edges == 0 and volumes is not None:
+            standing = _standing_orientation(block, volumes)
+            if standing is not None:
+                out.append(standing)
+                continue
         shell = block_shell(points, triangles_of, block)
         if open_edges is None:  # some triangles to turn: the whole rule
             out.append(_shell_orientation(block, shell))
@@ -215,14 +241,136 @@ def block_orientations(scene: Scene) -> list[BlockOrientation]:
     return out
 
 
-def _patch_areas(points: FloatArray, triangles_of: dict[int, IntArray]) -> dict[int, FloatArray]:
-    """The area of every triangle of every patch (one pass over all of them)."""
+@dataclass(frozen=True)
+class _PatchVolumes:
+    """Six times each patch's share of the signed volume of a closed shell through it (its
+    triangles about one origin, as a shell on the patch's negative side lists them), its
+    triangle count, and what bounds the rounding of a shell's sum."""
+
+    sextuple: dict[int, float]
+    count: dict[int, int]
+    diameter: float  # of the points' box: no point is farther from a centre inside it
+    reach: float  # the largest distance of a point from the coordinates' origin
+
+
+def _patch_measures(
+    points: FloatArray,
+    triangles_of: dict[int, IntArray],
+    with_volumes: bool,
+    with_areas: bool = True,
+) -> tuple[dict[int, FloatArray], _PatchVolumes | None]:
+    """The area of every triangle of every patch (one pass over all of them; none without
+    ``with_areas``) and, with ``with_volumes``, their :class:`_PatchVolumes`."""
     ids = list(triangles_of)
     if not ids:
-        return {}
+        return {}, None
     counts = np.array([triangles_of[i].shape[0] for i in ids], dtype=np.int64)
-    areas = mesh.face_areas(points, np.concatenate([triangles_of[i] for i in ids]))
-    return dict(zip(ids, np.split(areas, np.cumsum(counts)[:-1]), strict=True))
+    triangles = np.concatenate([triangles_of[i] for i in ids])
+    cuts = np.cumsum(counts)[:-1]
+    by_patch: dict[int, FloatArray] = {}
+    if with_areas:
+        by_patch = dict(zip(ids, np.split(mesh.face_areas(points, triangles), cuts), strict=True))
+    if not with_volumes or not points.size:
+        return by_patch, None
+    low, high = column_extremes(points)
+    local = np.ascontiguousarray((points - 0.5 * (low + high)).T)
+    a, b, c = (np.take(local, triangles[:, k], axis=1) for k in range(3))
+    terms = a[0] * (b[1] * c[2] - b[2] * c[1])
+    terms += a[1] * (b[2] * c[0] - b[0] * c[2])
+    terms += a[2] * (b[0] * c[1] - b[1] * c[0])
+    shares = np.split(terms, cuts)
+    with np.errstate(over="ignore", invalid="ignore"):
+        diameter = float(np.hypot.reduce(high - low))
+        reach = float(np.hypot.reduce(np.maximum(np.abs(low), np.abs(high))))
+    return by_patch, _PatchVolumes(
+        sextuple={i: float(part.sum()) for i, part in zip(ids, shares, strict=True)},
+        count=dict(zip(ids, counts.tolist(), strict=True)),
+        diameter=diameter,
+        reach=reach,
+    )
+
+
+def _standing_on_joined(
+    scene: Scene, blocks: list[Block], joined: JoinedPatches
+) -> list[BlockOrientation] | None:
+    """Every block's :func:`_standing_orientation` on the ``joined`` mesh, or None when a
+    block is no standing one there or the mesh may not be the one :func:`patch_triangles`
+    joins: that one joins the points within the scene's tolerance, which is no larger than
+    ``joined.tolerance``, so when ``joined`` only joined copies of one point the two join the
+    same vertices and drop the same triangles (the patches the same surfaces' labels)."""
+    box = scene.bounds
+    tolerance = RELATIVE_MERGE_TOLERANCE * (box.diagonal if box else 1.0)
+    if not (joined.exact and tolerance <= joined.tolerance):
+        return None
+    position = {p.id: k for k, p in enumerate(joined.patches)}
+    surfaces = {scene.topology.patch(s.patch).surface for b in blocks for s in b.sides}
+    bounds = np.searchsorted(joined.owners, np.arange(len(joined.patches) + 1)).tolist()
+    triangles_of: dict[int, IntArray] = {}
+    for patch in scene.topology.patches:  # the patches patch_triangles gives triangles to
+        if patch.surface not in surfaces:
+            continue
+        k = position.get(patch.id)
+        if k is None:
+            return None
+        listed = joined.patches[k]
+        if (listed.surface, listed.label) != (patch.surface, patch.label) or (
+            joined.surfaces[k] is not scene.get(patch.surface)
+        ):
+            return None
+        triangles_of[patch.id] = joined.triangles[bounds[k] : bounds[k + 1]]
+    edges = patch_edges(triangles_of, int(joined.points.shape[0]))
+    _, volumes = _patch_measures(joined.points, triangles_of, with_volumes=True, with_areas=False)
+    if edges is None or volumes is None:
+        return None
+    out = []
+    for block in blocks:
+        if any(side.patch not in triangles_of for side in block.sides):
+            return None
+        if open_edges_if_one_way(edges, block) != 0:
+            return None
+        standing = _standing_orientation(block, volumes)
+        if standing is None:
+            return None
+        out.append(standing)
+    return out
+
+
+def _patch_areas(points: FloatArray, triangles_of: dict[int, IntArray]) -> dict[int, FloatArray]:
+    """The area of every triangle of every patch (one pass over all of them)."""
+    return _patch_measures(points, triangles_of, with_volumes=False)[0]
+
+
+def _standing_orientation(block: Block, volumes: _PatchVolumes) -> BlockOrientation | None:
+    """The orientation of a closed ``block`` whose shell runs one way, from the volumes of
+    its patches, when its sides stand and the sum leaves the sign of its volume (as
+    :func:`_one_way_orientation` computes it) beyond doubt; else None.
+
+    Both computations lie within ``bound`` (six times a volume) of the volume the shell's
+    points enclose: each of the ``n`` triple products of coordinates within ``d`` of their
+    origin (the points' box centre here, the shell's there) is rounded by less than
+    ``64 eps d^3`` and summed, in whatever order, with less than ``n eps`` times the sum of
+    their sizes (each below ``11 d^3``); the shifts of the points (coordinates up to ``r``)
+    move each by less than ``2 eps r``, hence each product by less than ``12 eps r d^2``.
+    """
+    internal = block.internal_patches
+    total = 0.0
+    n = 0
+    for patch, side in block.sides:
+        if patch in internal:
+            continue
+        share = volumes.sextuple[patch]
+        total += -share if side == 1 else share  # the positive side lists it flipped
+        n += volumes.count[patch]
+    eps = float(np.finfo(np.float64).eps)
+    d, r = volumes.diameter, volumes.reach
+    with np.errstate(over="ignore", invalid="ignore"):
+        bound = eps * n * ((64.0 + 11.0 * (n + 1)) * d**3 + 12.0 * r * d * d)
+    if not (np.isfinite(total) and np.isfinite(bound) and abs(total) > 2.0 * bound):
+        return None
+    volume = total / 6.0
+    if (volume < 0) != block.is_universe:  # a side to reverse: measured as written
+        return None
+    return BlockOrientation(block, tuple(block.sides), (), volume, 0)
 
 
 def _one_way_orientation(
@@ -237,13 +385,15 @@ def _one_way_orientation(
     return _decide(block, np.zeros(len(boundary), dtype=np.bool_), volume, area, open_edges)
 
 
-def orient_blocks(scene: Scene) -> tuple[Scene, list[str]]:
+def orient_blocks(scene: Scene, joined: JoinedPatches | None = None) -> tuple[Scene, list[str]]:
     """``scene`` with every block's sides orienting its boundary outward; one note per repair.
 
     Blocks enclose positive volume and the universe negative volume afterwards; patches record
     their new positive and negative blocks. A block that cannot be oriented is a TopologyError.
+    ``joined``: the patches as a reader joined them to find the corners and arcs (see
+    :func:`block_orientations`), for the usual model's blocks to be checked on that mesh.
     """
-    orientations = block_orientations(scene)
+    orientations = block_orientations(scene, exact_volumes=False, joined=joined)
     notes: list[str] = []
     changed = {int(o.block.id or 0): o for o in orientations if o.changed}
     for item in orientations:

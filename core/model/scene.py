@@ -4,12 +4,19 @@ from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
-from functools import cached_property
-from typing import Annotated, Any, Self, TypeVar
+from functools import cache, cached_property
+from typing import Annotated, Any, Self, TypeVar, get_args
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BeforeValidator, Field, JsonValue, ValidationError, model_validator
+from pydantic import (
+    BeforeValidator,
+    Field,
+    JsonValue,
+    TypeAdapter,
+    ValidationError,
+    model_validator,
+)
 
 from geobrep.errors import (
     EntityNotFoundError,
@@ -96,6 +103,16 @@ def _assign_ids(entities: Sequence[Any]) -> list[Any]:
     return result
 
 
+#: The entity classes a scene holds (the members of ``AnyEntity``).
+_ENTITY_CLASSES: frozenset[type] = frozenset(get_args(get_args(AnyEntity)[0]))
+
+
+@cache
+def _json_object() -> TypeAdapter[dict[str, JsonValue]]:
+    """Validates a scene's ``metadata`` as its field does."""
+    return TypeAdapter(dict[str, JsonValue])
+
+
 class Scene(FrozenModel):
     """A structural model: entities, groups, CRS and topology.
 
@@ -129,6 +146,55 @@ class Scene(FrozenModel):
             message = first["msg"].removeprefix("Value error, ")
             raise EntityValidationError("Scene", loc, message) from exc
 
+    @classmethod
+    def from_validated(
+        cls,
+        *,
+        entities: Sequence[Entity],
+        groups: Sequence[Group] = (),
+        crs: CRS | None = None,
+        topology: Topology | None = None,
+        name: str = "",
+        metadata: dict[str, Any] | None = None,
+    ) -> Scene:
+        """The scene ``Scene(entities=..., ...)`` makes of parts that are models validated
+        already (a reader's), checked as that would check them but without validating the
+        parts again: the entities, groups and topology are taken as they are, the metadata
+        validated, ids given and references checked. Parts of any other kind go through the
+        constructor. (The scene's own schema, one branch per entity type, is then built only
+        when a scene is first validated.)
+        """
+        values: dict[str, Any] = {
+            "entities": entities,
+            "groups": groups,
+            "crs": crs,
+            "topology": topology if topology is not None else Topology(),
+            "name": name,
+            "metadata": metadata if metadata is not None else {},
+        }
+        taken = (
+            all(type(e) in _ENTITY_CLASSES for e in entities)
+            and all(type(g) is Group for g in groups)
+            and (crs is None or type(crs) is CRS)
+            and type(values["topology"]) is Topology
+            and type(name) is str
+        )
+        if not taken:
+            return cls(**values)
+        try:
+            checked = _json_object().validate_python(values["metadata"])
+        except ValidationError as exc:  # as the constructor reports it
+            first = exc.errors()[0]
+            loc = ".".join(str(p) for p in ("metadata", *first["loc"]))
+            message = first["msg"].removeprefix("Value error, ")
+            raise EntityValidationError("Scene", loc, message) from exc
+        values["entities"] = tuple(_assign_ids(list(entities)))
+        values["groups"] = tuple(groups)
+        values["metadata"] = checked
+        scene = cls.model_construct(**values)
+        scene._check_ids_and_references()
+        return scene
+
     @model_validator(mode="before")
     @classmethod
     def _give_ids(cls, data: Any) -> Any:
@@ -138,6 +204,10 @@ class Scene(FrozenModel):
 
     @model_validator(mode="after")
     def _check_references(self) -> Self:
+        self._check_ids_and_references()
+        return self
+
+    def _check_ids_and_references(self) -> None:
         ids = [entity.id for entity in self.entities]
         if len(set(ids)) != len(ids):
             duplicate = next(i for i in ids if ids.count(i) > 1)
@@ -150,7 +220,6 @@ class Scene(FrozenModel):
                     "Scene", f"groups[{group.name!r}]", f"member {missing[0]} is not an entity id"
                 )
         self._check_topology()
-        return self
 
     def _check_topology(self) -> None:
         by_id = self.entity_by_id
