@@ -254,6 +254,10 @@ def _spread_rows(
     np.maximum.at(planes_high, c_key, group)
     wanted |= planes_low[c_key] < planes_high[c_key]
     c_box, c_key = c_box[wanted], c_key[wanted]
+    # Only the wanted blocks the triangle itself comes near: a fine cell it comes near lies in
+    # one (the cell grown by the margin lies in its block grown by the margin).
+    touching = coarse.touches(stored[:, :, c_box], c_key, margin)
+    c_box, c_key = c_box[touching], c_key[touching]
     # The cells of each wanted block inside the triangle's box.
     start = coarse.index(c_key) << shift
     position = np.searchsorted(spread, c_box)
