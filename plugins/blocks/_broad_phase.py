@@ -47,16 +47,30 @@ _SLICE = 32_768
 _OFFSETS = np.array([[(c >> 2) & 1, (c >> 1) & 1, c & 1] for c in range(8)], dtype=np.int64).T
 
 
-def _boxes(corners: FloatArray, margin: float) -> tuple[FloatArray, FloatArray]:
-    """Boxes of triangles stored component-major, (corner, xyz, K): mins and maxs (xyz, K)."""
+def _boxes(corners: FloatArray, margin: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Boxes of triangles stored component-major, (corner, xyz, K): mins and maxs (xyz, K), and
+    each box's largest side (K), margins included.
+
+    In slices whose temporaries stay in cache (the same operations as on whole rows)."""
+    n = corners.shape[2]
+    low, high = np.empty((3, n)), np.empty((3, n))
+    extent = np.empty(n)
     a, b, c = corners[0], corners[1], corners[2]
-    low, high = np.minimum(a, b), np.maximum(a, b)
-    np.minimum(low, c, out=low)
-    np.maximum(high, c, out=high)
-    if margin:
-        low -= margin
-        high += margin
-    return low, high
+    for start in range(0, n, _SLICE):
+        rows = slice(start, start + _SLICE)
+        part_low, part_high = low[:, rows], high[:, rows]
+        np.minimum(a[:, rows], b[:, rows], out=part_low)
+        np.maximum(a[:, rows], b[:, rows], out=part_high)
+        np.minimum(part_low, c[:, rows], out=part_low)
+        np.maximum(part_high, c[:, rows], out=part_high)
+        if margin:
+            part_low -= margin
+            part_high += margin
+        size = part_high - part_low
+        part = extent[rows]
+        np.maximum(size[0], size[1], out=part)
+        np.maximum(part, size[2], out=part)
+    return low, high, extent
 
 
 def _dilated(values: NDArray[Any], op: Callable[..., object]) -> NDArray[Any]:
@@ -103,11 +117,11 @@ class _Grid:
 
     def ranges(self, mins: FloatArray, maxs: FloatArray) -> tuple[IntArray, IntArray]:
         """First cell (xyz, K) of each box and how many cells past it the box reaches."""
-        # Offsets from the origin are not negative for the boxes the grid was made over, so a
-        # truncating cast floors them; x · (1 / size) is monotone in x like x / size, so boxes
-        # that overlap still share a cell (and the cell geometry of :meth:`touches` allows for
-        # the rounding).
-        # In slices whose temporaries stay in cache.
+        # Offsets from the origin are not negative for the boxes the grid was made over (the
+        # origin is their least corner, and x - y >= 0 exactly when x >= y), so a truncating
+        # cast floors them; x · (1 / size) is monotone in x like x / size, so boxes that overlap
+        # still share a cell (and the cell geometry of :meth:`touches` allows for the rounding).
+        # In slices whose temporaries stay in cache, cast straight into the result.
         scale, top = 1.0 / self.size, self.dims[:, None] - 1
         n = mins.shape[1]
         first, last = np.empty((3, n), dtype=np.int64), np.empty((3, n), dtype=np.int64)
@@ -116,10 +130,9 @@ class _Grid:
             for bound, cells in ((mins, first), (maxs, last)):
                 offset = bound[:, rows] - self.origin
                 offset *= scale
-                np.maximum(offset, 0.0, out=offset)
-                part = offset.astype(np.int64)
+                part = cells[:, rows]
+                np.copyto(part, offset, casting="unsafe")  # truncation, as astype
                 np.minimum(part, top, out=part)
-                cells[:, rows] = part
         last -= first
         return first, last
 
@@ -377,9 +390,7 @@ def stored_pairs(
     empty = np.zeros(0, dtype=np.int64)
     if n == 0:
         return empty, empty
-    mins, maxs = _boxes(stored, margin)
-    size = maxs - mins
-    extent = np.maximum(np.maximum(size[0], size[1]), size[2])  # margins included
+    mins, maxs, extent = _boxes(stored, margin)  # extents: margins included
     if cell is None:
         cell = _CELL_FACTOR * float(np.median(extent - 2.0 * margin))
     origin, top = mins.min(axis=1), maxs.max(axis=1)
