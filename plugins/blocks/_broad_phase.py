@@ -77,16 +77,20 @@ def _dilated(values: NDArray[Any], op: Callable[..., object]) -> NDArray[Any]:
     """``op`` (``np.minimum`` or ``np.maximum``) over the 3 x 3 x 3 cells around each cell.
 
     One axis at a time, in the array's own memory order (slices along the axis, no transposed
-    copies): each pass reads the values before it from a plain copy."""
+    copies): ``op`` of each pair of neighbours, then of each pair of those pairs."""
     out = np.array(values, order="C")
     for axis in range(3):
-        before = out.copy()
+        if out.shape[axis] < 2:
+            continue
 
         def part(start: int | None, stop: int | None, axis: int = axis) -> tuple[slice, ...]:
             return tuple(slice(start, stop) if k == axis else slice(None) for k in range(3))
 
-        op(out[part(1, None)], before[part(None, -1)], out=out[part(1, None)])
-        op(out[part(None, -1)], before[part(1, None)], out=out[part(None, -1)])
+        pairs = np.empty_like(out[part(1, None)])
+        op(out[part(None, -1)], out[part(1, None)], out=pairs)  # cells k and k + 1
+        out[part(None, 1)] = pairs[part(None, 1)]
+        out[part(-1, None)] = pairs[part(-1, None)]
+        op(pairs[part(None, -1)], pairs[part(1, None)], out=out[part(1, -1)])
     return out
 
 
@@ -108,6 +112,14 @@ class _Grid:
         grid.strides = np.array([grid.dims[1] * grid.dims[2], grid.dims[2], 1], dtype=np.int64)
         grid.n_cells = int(np.prod(grid.dims))
         return grid
+
+    def keys(self, index: IntArray) -> IntArray:
+        """Cell keys of cell indices (xyz, R) (``strides @ index``: numpy's integer matrix
+        product is several times slower than these elementwise passes)."""
+        key = index[0] * self.strides[0]
+        key += index[1] * self.strides[1]
+        key += index[2]
+        return np.asarray(key)
 
     def index(self, key: IntArray) -> IntArray:
         """Cell indices (xyz, R) of cell keys."""
@@ -140,7 +152,7 @@ class _Grid:
         """Rows (box, cell key, offset code) of every cell of each box's range."""
         sizes = past + 1
         box = np.arange(sizes.shape[1], dtype=np.int64)
-        key = self.strides @ first
+        key = self.keys(first)
         code = np.zeros(box.shape[0], dtype=np.int64)
         # One axis at a time (x, then y, then z: rows by box, then dx, dy, dz): each row is
         # repeated as many times as the box spans cells along the axis, without divisions.
@@ -299,7 +311,7 @@ def _near_other_groups(
 
     A box reaching at most two cells per axis is entered in its first cell only: a box it
     overlaps has entered a cell of the 3 x 3 x 3 around that one."""
-    lower = grid.strides @ first
+    lower = grid.keys(first)
     spread = np.flatnonzero((past > 1).any(axis=0))
     dims = tuple(grid.dims.tolist())
     maximum = np.iinfo(groups.dtype).max
@@ -415,7 +427,7 @@ def stored_pairs(
     )
     code, which = np.nonzero(reached)
     box = compact[which]
-    key = (grid.strides @ first[:, compact])[which] + (grid.strides @ _OFFSETS)[code]
+    key = np.take(grid.keys(first[:, compact]), which) + (grid.strides @ _OFFSETS)[code]
     kept = near[s_box]
     box = np.concatenate([box, s_box[kept]])
     key = np.concatenate([key, s_key[kept]])
