@@ -127,26 +127,25 @@ class _Grid:
             [key // self.strides[0], (key // self.strides[1]) % self.dims[1], key % self.dims[2]]
         )
 
-    def ranges(self, mins: FloatArray, maxs: FloatArray) -> tuple[IntArray, IntArray]:
-        """First cell (xyz, K) of each box and how many cells past it the box reaches."""
-        # Offsets from the origin are not negative for the boxes the grid was made over (the
-        # origin is their least corner, and x - y >= 0 exactly when x >= y), so a truncating
-        # cast floors them; x · (1 / size) is monotone in x like x / size, so boxes that overlap
-        # still share a cell (and the cell geometry of :meth:`touches` allows for the rounding).
+    def cells_of(self, bounds: FloatArray) -> IntArray:
+        """The cell (xyz, K) holding each point ``bounds`` (xyz, K) of the boxes the grid was
+        made over."""
+        # Offsets from the origin are not negative for those boxes (the origin is their least
+        # corner, and x - y >= 0 exactly when x >= y), so a truncating cast floors them;
+        # x · (1 / size) is monotone in x like x / size, so boxes that overlap still share a
+        # cell (and the cell geometry of :meth:`touches` allows for the rounding).
         # In slices whose temporaries stay in cache, cast straight into the result.
         scale, top = 1.0 / self.size, self.dims[:, None] - 1
-        n = mins.shape[1]
-        first, last = np.empty((3, n), dtype=np.int64), np.empty((3, n), dtype=np.int64)
+        n = bounds.shape[1]
+        cells = np.empty((3, n), dtype=np.int64)
         for start in range(0, n, _SLICE):
             rows = slice(start, start + _SLICE)
-            for bound, cells in ((mins, first), (maxs, last)):
-                offset = bound[:, rows] - self.origin
-                offset *= scale
-                part = cells[:, rows]
-                np.copyto(part, offset, casting="unsafe")  # truncation, as astype
-                np.minimum(part, top, out=part)
-        last -= first
-        return first, last
+            offset = bounds[:, rows] - self.origin
+            offset *= scale
+            part = cells[:, rows]
+            np.copyto(part, offset, casting="unsafe")  # truncation, as astype
+            np.minimum(part, top, out=part)
+        return cells
 
     def cells(self, first: IntArray, past: IntArray) -> tuple[IntArray, IntArray, IntArray]:
         """Rows (box, cell key, offset code) of every cell of each box's range."""
@@ -301,24 +300,25 @@ def _spread_rows(
 def _near_other_groups(
     grid: _Grid,
     first: IntArray,
-    past: IntArray,
+    spread_boxes: tuple[IntArray, IntArray],
     groups: NDArray[np.integer],
     large: tuple[BoolArray, FloatArray, float],
-) -> tuple[BoolArray, IntArray, IntArray, IntArray, IntArray]:
+) -> tuple[BoolArray, IntArray, IntArray, IntArray]:
     """Which boxes may meet a box of another group, and the rows of the spread boxes (those
-    reaching more than two cells along an axis): box, cell key, offset code (``large``: which
-    boxes are large triangles, the corners and the margin, for :func:`_spread_rows`).
+    reaching more than two cells along an axis, ``spread_boxes``: their indices and how many
+    cells past their first they reach): box, cell key, offset code (``large``: which boxes are
+    large triangles, the corners and the margin, for :func:`_spread_rows`).
 
     A box reaching at most two cells per axis is entered in its first cell only: a box it
     overlaps has entered a cell of the 3 x 3 x 3 around that one."""
     lower = grid.keys(first)
-    spread = np.flatnonzero((past > 1).any(axis=0))
+    spread, past = spread_boxes
     dims = tuple(grid.dims.tolist())
     maximum = np.iinfo(groups.dtype).max
-    sizes = past[:, spread] + 1
+    sizes = past + 1
     if int((sizes[0] * sizes[1] * sizes[2]).sum()) <= _BLOCKS_OVER * first.shape[1]:
         # Few spread rows: all of them at once, one dilation.
-        box, key, code = grid.cells(first[:, spread], past[:, spread])
+        box, key, code = grid.cells(first[:, spread], past)
         box = spread[box]
         lowest = np.full(grid.n_cells, maximum, dtype=groups.dtype)
         highest = np.zeros(grid.n_cells, dtype=groups.dtype)
@@ -331,7 +331,7 @@ def _near_other_groups(
         near = mixed[lower]
         near[spread] = False
         near[box[mixed[key]]] = True
-        return near, spread, box, key, code
+        return near, box, key, code
     lowest = np.full(grid.n_cells, maximum, dtype=groups.dtype)
     highest = np.zeros(grid.n_cells, dtype=groups.dtype)
     np.minimum.at(lowest, lower, groups)
@@ -342,7 +342,7 @@ def _near_other_groups(
     )
     is_large, stored, margin = large
     box, key, code = _spread_rows(
-        grid, (spread, first[:, spread], past[:, spread]), around, is_large, stored, groups, margin
+        grid, (spread, first[:, spread], past), around, is_large, stored, groups, margin
     )
     if box.size:
         lowest = np.full(grid.n_cells, maximum, dtype=groups.dtype)
@@ -357,7 +357,7 @@ def _near_other_groups(
     near = mixed[lower]
     near[spread] = False
     near[box[mixed[key]]] = True
-    return near, spread, box, key, code
+    return near, box, key, code
 
 
 def overlapping_pairs(
@@ -411,23 +411,32 @@ def stored_pairs(
     grid = _Grid(origin, cell, top)
     shifted = np.asarray(groups) - int(np.min(groups))
     table = shifted.astype(np.min_scalar_type(int(shifted.max())))
-    first, past = grid.ranges(mins, maxs)
+    # The first cell of every box; the last only where needed: a box reaches three cells along
+    # an axis only when longer than a cell there (1e-6: far more than the rounding of the cell
+    # indices, under 2^20 cells per axis), and of the others only those near another group.
+    first = grid.cells_of(mins)
+    long = np.flatnonzero(extent > cell * (1.0 - 1e-6))
+    long_past = grid.cells_of(np.take(maxs, long, axis=1)) - np.take(first, long, axis=1)
+    spreading = (long_past > 1).any(axis=0)
+    spread = long[spreading]
     large = extent > cell * (_LARGE_FACTOR / _CELL_FACTOR) + 2.0 * margin
-    near, spread, s_box, s_key, s_code = _near_other_groups(
-        grid, first, past, table, (large, stored, margin)
+    near, s_box, s_key, s_code = _near_other_groups(
+        grid, first, (spread, long_past[:, spreading]), table, (large, stored, margin)
     )
     # Rows of the boxes left: those reaching at most two cells per axis from the offsets table.
     is_spread = np.zeros(n, dtype=np.bool_)
     is_spread[spread] = True
     compact = np.flatnonzero(near & ~is_spread)
+    compact_first = np.take(first, compact, axis=1)
+    past = grid.cells_of(np.take(maxs, compact, axis=1)) - compact_first
     reached = (
-        (_OFFSETS[0][:, None] <= past[0, compact])
-        & (_OFFSETS[1][:, None] <= past[1, compact])
-        & (_OFFSETS[2][:, None] <= past[2, compact])
+        (_OFFSETS[0][:, None] <= past[0])
+        & (_OFFSETS[1][:, None] <= past[1])
+        & (_OFFSETS[2][:, None] <= past[2])
     )
     code, which = np.nonzero(reached)
     box = compact[which]
-    key = np.take(grid.keys(first[:, compact]), which) + (grid.strides @ _OFFSETS)[code]
+    key = np.take(grid.keys(compact_first), which) + (grid.strides @ _OFFSETS)[code]
     kept = near[s_box]
     box = np.concatenate([box, s_box[kept]])
     key = np.concatenate([key, s_key[kept]])
@@ -495,14 +504,16 @@ def _cell_pairs(
     # along some axis (their offset codes share a bit). Gathers are np.take: on numpy 2 it is
     # several times faster than fancy indexing.
     canonical = np.flatnonzero((np.take(code, first_row) & np.take(code, second_row)) == 0)
-    first = np.take(box, np.take(first_row, canonical))
-    second = np.take(box, np.take(second_row, canonical))
-    keep = np.ones(first.shape[0], dtype=np.bool_)
+    first_row, second_row = np.take(first_row, canonical), np.take(second_row, canonical)
+    # The boxes' bounds gathered per row first: the pairs then gather from arrays as long as
+    # the rows, not the boxes (fewer cache misses), and only kept pairs gather their boxes.
+    keep = np.ones(first_row.shape[0], dtype=np.bool_)
     for k in range(3):
-        low, high = mins[k], maxs[k]
-        keep &= np.take(low, first) <= np.take(high, second)
-        keep &= np.take(low, second) <= np.take(high, first)
-    first, second = first[keep], second[keep]
+        low, high = np.take(mins[k], box), np.take(maxs[k], box)
+        keep &= np.take(low, first_row) <= np.take(high, second_row)
+        keep &= np.take(low, second_row) <= np.take(high, first_row)
+    first = np.take(box, np.compress(keep, first_row))
+    second = np.take(box, np.compress(keep, second_row))
     once = ~(large[first] | large[second])
     if once.all():
         return first.astype(np.int64, copy=False), second.astype(np.int64, copy=False)
