@@ -195,30 +195,6 @@ class _Grid:
         return np.asarray(near)
 
 
-def _near_planes(
-    grid: _Grid, corners: FloatArray, which: IntArray, key: IntArray, margin: float
-) -> BoolArray:
-    """Whether the plane of triangle ``which[r]`` of ``corners`` (component-major, (corner,
-    xyz, W)) comes within ``margin`` of cell ``key[r]`` (a superset of the cells the triangle
-    comes near: the plane-normal axis of :meth:`_Grid.touches`, one normal per triangle)."""
-    one, two = corners[1] - corners[0], corners[2] - corners[0]
-    normal = np.stack(
-        [
-            one[1] * two[2] - one[2] * two[1],
-            one[2] * two[0] - one[0] * two[2],
-            one[0] * two[1] - one[1] * two[0],
-        ]
-    )
-    offset = (normal * corners[0]).sum(axis=0)
-    radius = (0.5 * grid.size + margin) * (1.0 + 1e-9)
-    reach = radius * np.abs(normal).sum(axis=0)
-    centre = grid.index(key) * grid.size + (grid.origin + 0.5 * grid.size)
-    height = np.take(normal[0], which) * centre[0] - np.take(offset, which)
-    height += np.take(normal[1], which) * centre[1]
-    height += np.take(normal[2], which) * centre[2]
-    return np.asarray(np.abs(height) <= np.take(reach, which))
-
-
 def _block_extremes(values: NDArray[Any], factor: int, lowest: bool) -> NDArray[Any]:
     """Least (``lowest``) or greatest value of each block of ``factor`` ³ cells of a dense
     (X, Y, Z) grid, flattened in block order."""
@@ -233,6 +209,15 @@ def _block_extremes(values: NDArray[Any], factor: int, lowest: bool) -> NDArray[
     return np.ascontiguousarray(values).reshape(-1)
 
 
+def _groups_differ(n_cells: int, key: IntArray, group: NDArray[np.integer]) -> BoolArray:
+    """Whether rows of another group than each row's share its cell ``key`` (of ``n_cells``)."""
+    low = np.full(n_cells, np.iinfo(group.dtype).max, dtype=group.dtype)
+    high = np.zeros(n_cells, dtype=group.dtype)
+    np.minimum.at(low, key, group)
+    np.maximum.at(high, key, group)
+    return np.asarray(low[key] < high[key])
+
+
 def _spread_rows(
     grid: _Grid,
     boxes: tuple[IntArray, IntArray, IntArray],
@@ -245,13 +230,14 @@ def _spread_rows(
     """Rows (box, cell key, offset code) of the spread boxes ``boxes`` = (indices, first
     cells, cells past them). ``around`` is the least and greatest group whose boxes have
     their first cell in the 3 x 3 x 3 cells around each cell (dense grids). A large triangle
-    has rows only in the blocks of :data:`_COARSE` ³ cells its plane comes near where another
-    group is around, or where the plane of a large triangle of another group comes near too.
+    has rows only in the blocks of :data:`_COARSE` ³ cells it comes near where another group
+    is around (or has a spread box reaching the block), or where a large triangle of another
+    group comes near too.
 
     A large triangle spans many cells, most of them far from any other surface: the blocks
     tell where its cells can matter before they are listed. A cell matters to it only where
-    a box of another group has its first cell around (they may pair or make each other near)
-    or where a large triangle of another group comes near it too.
+    a box of another group has its first cell around or reaches it (they may pair or make each
+    other near) or where a large triangle of another group comes near it too.
     Offset codes of large triangles are 0 (their pairs are deduplicated instead)."""
     spread, first, past = boxes
     big = large[spread]
@@ -264,24 +250,35 @@ def _spread_rows(
     shift = _COARSE.bit_length() - 1
     low = first[:, big] >> shift
     c_box, c_key, _ = coarse.cells(low, ((first[:, big] + past[:, big]) >> shift) - low)
-    position = np.searchsorted(wide, wide[c_box])
     c_box = wide[c_box]
-    near = _near_planes(coarse, stored[:, :, wide], position, c_key, margin)
-    c_box, c_key = c_box[near], c_key[near]
     group = groups[c_box]
     lowest = _block_extremes(around[0], _COARSE, lowest=True)
     highest = _block_extremes(around[1], _COARSE, lowest=False)
     wanted = (lowest[c_key] < group) | (highest[c_key] > group)
-    planes_low = np.full(coarse.n_cells, np.iinfo(groups.dtype).max, dtype=groups.dtype)
-    planes_high = np.zeros(coarse.n_cells, dtype=groups.dtype)
-    np.minimum.at(planes_low, c_key, group)
-    np.maximum.at(planes_high, c_key, group)
-    wanted |= planes_low[c_key] < planes_high[c_key]
-    c_box, c_key = c_box[wanted], c_key[wanted]
-    # Only the wanted blocks the triangle itself comes near: a fine cell it comes near lies in
-    # one (the cell grown by the margin lies in its block grown by the margin).
+    if box.size:
+        # The other spread boxes enter every cell they reach, which may lie two cells past
+        # their first (beyond ``around``): the blocks of those cells, by group.
+        block = coarse.keys(grid.index(key) >> shift)
+        spread_low = np.full(coarse.n_cells, np.iinfo(groups.dtype).max, dtype=groups.dtype)
+        spread_high = np.zeros(coarse.n_cells, dtype=groups.dtype)
+        np.minimum.at(spread_low, block, groups[box])
+        np.maximum.at(spread_high, block, groups[box])
+        wanted |= (spread_low[c_key] < group) | (spread_high[c_key] > group)
+    # Blocks that large triangles of two groups reach, then come near: a fine cell a triangle
+    # comes near lies in a block it comes near (the cell grown by the margin lies in its block
+    # grown by the margin), so only those blocks' cells can pair the two.
+    shared = _groups_differ(coarse.n_cells, c_key, group)
+    tested = np.flatnonzero(wanted | shared)
+    c_box, c_key, group, wanted = c_box[tested], c_key[tested], group[tested], wanted[tested]
     touching = coarse.touches(stored[:, :, c_box], c_key, margin)
-    c_box, c_key = c_box[touching], c_key[touching]
+    c_box, c_key, group, wanted = (
+        c_box[touching],
+        c_key[touching],
+        group[touching],
+        wanted[touching],
+    )
+    wanted |= _groups_differ(coarse.n_cells, c_key, group)
+    c_box, c_key = c_box[wanted], c_key[wanted]
     # The cells of each wanted block inside the triangle's box.
     start = coarse.index(c_key) << shift
     position = np.searchsorted(spread, c_box)
