@@ -60,3 +60,21 @@ def test_layer_cake_walls(monkeypatch: pytest.MonkeyPatch) -> None:
         )
         assert direct == blocked
         assert len(direct) > 1000
+
+
+def test_spread_box_two_cells_past_its_first(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Boxes longer than a cell but not large reach cells two past their first, beyond the
+    # 3 x 3 x 3 around it: a large triangle's block holding only such a cell still pairs them
+    # (a random soup where blocks wanted only for the boxes' first cells miss a pair).
+    rng = np.random.default_rng(11)
+    n = int(rng.integers(2, 3000))
+    centres = rng.uniform(0, 10, (n, 1, 3))
+    big = rng.random((n, 1, 1)) < 0.05
+    scale = np.where(big, rng.uniform(2, 8, (n, 1, 1)), rng.uniform(0.05, 0.6, (n, 1, 1)))
+    corners = centres + scale * rng.normal(size=(n, 3, 3))
+    groups = np.sort(rng.integers(0, int(rng.integers(2, 12)), n))
+    direct, blocked = both_ways(
+        monkeypatch, lambda: overlapping_pairs(corners, groups, 0.1, cell=0.3)
+    )
+    assert (224, 375) in direct
+    assert direct == blocked
