@@ -18,6 +18,7 @@ shares between leaves are written in each, with the same float32 value).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -58,13 +59,16 @@ def splittable(geometry: Entity) -> bool:
     return isinstance(geometry, Surface | PointSet)
 
 
-def _halves(ids: IntArray, centres: NDArray[np.float64], limit: int) -> list[Any]:
+def _halves(
+    ids: IntArray, centres: NDArray[np.float64], limit: int, whole: bool = False
+) -> list[Any]:
     """The k-d tree of element ``ids`` (nested lists of id arrays, each in increasing order),
     leaves of ``limit``; ``centres`` holds one row per axis (a centre's coordinates, or any
-    fixed multiple of them)."""
+    fixed multiple of them). ``whole``: ``ids`` are all the elements, in order (the rows of
+    ``centres`` are then their columns as they stand, not gathered)."""
     if len(ids) <= limit:
         return [ids]
-    columns = [axis[ids] for axis in centres]
+    columns = list(centres) if whole else [axis[ids] for axis in centres]
     axis = int(np.argmax([np.ptp(column) for column in columns]))
     half = len(ids) // 2
     lower = np.zeros(len(ids), bool)
@@ -72,17 +76,39 @@ def _halves(ids: IntArray, centres: NDArray[np.float64], limit: int) -> list[Any
     return [_halves(ids[lower], centres, limit), _halves(ids[~lower], centres, limit)]
 
 
+class _Scratch:
+    """Two arrays over a surface's vertices, reused by its leaves: which vertices a leaf's
+    triangles use, and their numbers in the leaf. A leaf touches only the span of vertex ids
+    its triangles reach and leaves ``used`` as it found it, so a split into ``k`` leaves costs
+    what its triangles cost, not ``k`` passes over every vertex."""
+
+    def __init__(self, n: int) -> None:
+        self.used = np.zeros(n, bool)
+        self.local = np.empty(n, np.int64)
+
+    def vertices(self, corners: IntArray) -> IntArray:
+        """The vertices ``corners`` use, in increasing order."""
+        if corners.size == 0:
+            return np.zeros(0, np.int64)
+        low, high = int(corners.min()), int(corners.max()) + 1
+        self.used[corners] = True
+        ids = np.flatnonzero(self.used[low:high])
+        ids += low
+        self.used[ids] = False
+        return ids
+
+
 def _surface_part(
-    surface: Surface, source: Entity, faces: IntArray, loose: NDArray[np.bool_] | None
+    surface: Surface, source: Entity, faces: IntArray, scratch: _Scratch, loose: IntArray | None
 ) -> Part:
-    """The leaf of ``surface`` holding ``faces`` (and the ``loose`` vertices, no triangle's)."""
-    n = surface.n_vertices
+    """The leaf of ``surface`` holding ``faces`` (and the ``loose`` vertices, which no
+    triangle uses)."""
     corners = np.asarray(surface.faces)[faces]
-    used = np.zeros(n, bool) if loose is None else loose.copy()
-    used[corners] = True
-    vertex_ids = np.flatnonzero(used)
-    local = np.cumsum(used, dtype=np.int64)
-    local -= 1
+    vertex_ids = scratch.vertices(corners)
+    if loose is not None and len(loose):
+        vertex_ids = np.union1d(vertex_ids, loose)
+    local = scratch.local
+    local[vertex_ids] = np.arange(len(vertex_ids))
     labels = None if surface.patch_labels is None else surface.patch_labels[faces]
     geometry = surface.replace(
         vertices=surface.vertices[vertex_ids],
@@ -92,14 +118,21 @@ def _surface_part(
         cell_data=surface.cell_data.take(faces),
     )
     shown = geometry if source is surface else source
-    return Part(geometry, shown, vertex_ids, faces, n, surface.n_faces)
+    return Part(geometry, shown, vertex_ids, faces, surface.n_vertices, surface.n_faces)
 
 
-def _loose(surface: Surface) -> NDArray[np.bool_]:
-    """Which vertices of ``surface`` no triangle uses (they travel in the first leaf)."""
-    loose = np.ones(surface.n_vertices, bool)
-    loose[np.asarray(surface.faces)] = False
-    return loose
+def _surface_parts(surface: Surface, source: Entity, ids: list[IntArray]) -> list[Part]:
+    """The leaves of ``surface`` holding the triangles ``ids`` (one array per leaf), the
+    vertices no triangle uses travelling in the first. The first leaf is made last, once the
+    others have said which vertices they hold."""
+    scratch = _Scratch(surface.n_vertices)
+    rest = [_surface_part(surface, source, faces, scratch, None) for faces in ids[1:]]
+    held = np.zeros(surface.n_vertices, bool)
+    for part in rest:
+        held[part.vertex_ids] = True
+    held[np.asarray(surface.faces)[ids[0]]] = True
+    first = _surface_part(surface, source, ids[0], scratch, np.flatnonzero(~held))
+    return [first, *rest]
 
 
 def _points_part(points: PointSet, source: Entity, ids: IntArray) -> Part:
@@ -108,17 +141,28 @@ def _points_part(points: PointSet, source: Entity, ids: IntArray) -> Part:
     return Part(geometry, shown, ids, np.zeros(0, np.int64), points.n_points, 0)
 
 
-def _parts(mesh: Entity, source: Entity, tree: list[Any], first: list[bool]) -> SplitTree:
+def _leaf_ids(tree: list[Any]) -> list[IntArray]:
+    """The id arrays of ``tree``'s leaves, left to right."""
     if len(tree) == 1:
-        ids = tree[0]
-        if isinstance(mesh, Surface):
-            part = _surface_part(mesh, source, ids, _loose(mesh) if first[0] else None)
-        else:
-            assert isinstance(mesh, PointSet)
-            part = _points_part(mesh, source, ids)
-        first[0] = False
-        return part
-    return [_parts(mesh, source, half, first) for half in tree]
+        return [tree[0]]
+    return [ids for half in tree for ids in _leaf_ids(half)]
+
+
+def _shaped(tree: list[Any], parts: Iterator[Part]) -> SplitTree:
+    """The next of ``parts`` (one per leaf, left to right) in the shape of ``tree``."""
+    if len(tree) == 1:
+        return next(parts)
+    return [_shaped(half, parts) for half in tree]
+
+
+def _parts(mesh: Entity, source: Entity, tree: list[Any]) -> SplitTree:
+    ids = _leaf_ids(tree)
+    if isinstance(mesh, Surface):
+        parts = _surface_parts(mesh, source, ids)
+    else:
+        assert isinstance(mesh, PointSet)
+        parts = [_points_part(mesh, source, leaf) for leaf in ids]
+    return _shaped(tree, iter(parts))
 
 
 def split_mesh(geometry: Entity, source: Entity, limit: int) -> SplitTree:
@@ -134,8 +178,8 @@ def split_mesh(geometry: Entity, source: Entity, limit: int) -> SplitTree:
         centres, count = np.asarray(geometry.vertices, np.float64).T, geometry.n_points
     else:
         raise TypeError(f"{geometry.type} meshes are not split")
-    tree = _halves(np.arange(count, dtype=np.int64), centres, max(1, limit))
-    return _parts(geometry, source, tree, [True])
+    tree = _halves(np.arange(count, dtype=np.int64), centres, max(1, limit), whole=True)
+    return _parts(geometry, source, tree)
 
 
 def leaves(tree: SplitTree) -> list[Part]:
