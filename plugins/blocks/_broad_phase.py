@@ -325,10 +325,7 @@ def _near_other_groups(
         mixed = (
             _dilated(lowest.reshape(dims), np.minimum) < _dilated(highest.reshape(dims), np.maximum)
         ).reshape(-1)
-        near = mixed[lower]
-        near[spread] = False
-        near[box[mixed[key]]] = True
-        return near, box, key, code
+        return _near_and_rows(mixed, lower, spread, (box, key, code))
     lowest = np.full(grid.n_cells, maximum, dtype=groups.dtype)
     highest = np.zeros(grid.n_cells, dtype=groups.dtype)
     np.minimum.at(lowest, lower, groups)
@@ -351,9 +348,27 @@ def _near_other_groups(
             np.maximum(around[1], _dilated(highest.reshape(dims), np.maximum)),
         )
     mixed = (around[0] < around[1]).reshape(-1)
+    return _near_and_rows(mixed, lower, spread, (box, key, code))
+
+
+def _near_and_rows(
+    mixed: BoolArray, lower: IntArray, spread: IntArray, rows: tuple[IntArray, IntArray, IntArray]
+) -> tuple[BoolArray, IntArray, IntArray, IntArray]:
+    """Which boxes are near another group's (``mixed``: the cells with two groups' boxes in
+    the 3 x 3 x 3 around them, ``lower``: every box's first cell, ``spread``: the spread boxes)
+    and the spread boxes' ``rows`` (box, cell key, code) in mixed cells only.
+
+    A row in a cell that is not mixed can never pair: a cell pairs boxes of two groups that
+    have rows there, and every row of a box lies in its first cell or in one of the 3 x 3 x 3
+    around it (a compact box) or is one of the spread rows (whose cells ``mixed`` counts), so
+    two groups with rows in a cell make it mixed. Such rows would be dropped with the cells
+    that only one group reaches; they are dropped here, before they are gathered again."""
+    box, key, code = rows
     near = mixed[lower]
     near[spread] = False
-    near[box[mixed[key]]] = True
+    live = mixed[key]
+    box, key, code = box[live], key[live], code[live]
+    near[box] = True
     return near, box, key, code
 
 
