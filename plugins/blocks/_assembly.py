@@ -16,6 +16,7 @@ import numpy as np
 
 from geobrep import Arc, Block, Corner, Entity, Group, Patch, PatchSide, Scene, Surface, Topology
 from geobrep.geometry.arrays import IntArray
+from geobrep.model.arrays import as_readonly
 from geobrep.plugins import UNIVERSE_KIND
 from geobrep.plugins.blocks._arcs import ArcChains
 from geobrep.plugins.blocks._measures import PatchMeasures
@@ -150,7 +151,17 @@ def assemble(
     topology = _topology(soup, split, chains, arcs, bodies, block_id)
     groups = _groups(scene, {int(e.id or 0) for e in kept}, [int(b.id or 0) for b in blocks])
     internal = [p.id for p in topology.patches if p.is_internal]
-    built = scene.replace(entities=(*kept, *blocks), topology=topology, groups=groups)
+    # The parts are validated models (the input's entities, the rebuilt surfaces, the blocks,
+    # the topology and the groups): the scene checks ids and references without validating
+    # them again.
+    built = Scene.from_validated(
+        entities=(*kept, *blocks),
+        groups=groups,
+        crs=scene.crs,
+        topology=topology,
+        name=scene.name,
+        metadata=scene.metadata,
+    )
     return Assembly(built, removed, internal, vertex_ids)
 
 
@@ -163,23 +174,32 @@ def _topology(
     block_id: dict[int, int],
 ) -> Topology:
     around = arcs.around
+    # Corners, arcs and patches are built from checked data (the soup's finite vertices, arcs
+    # of at least one edge between numbered corners, ids and labels counted from 0): what their
+    # validation would do is done here. The topology checks its references.
     corners = tuple(
-        Corner(id=k, point=soup.vertices[v]) for k, v in enumerate(chains.corners.tolist())
+        Corner.model_construct(id=k, point=as_readonly(soup.vertices[v]))
+        for k, v in enumerate(chains.corners.tolist())
     )
     patch_arcs: list[set[int]] = [set() for _ in range(split.n_patches)]
     for arc, patch in zip(around.arc.tolist(), around.patch.tolist(), strict=True):
         patch_arcs[patch].add(arc)
     arc_list = []
+    bounds, offsets = chains.chain_offsets.tolist(), around.offsets.tolist()
+    starts, ends, members = (
+        chains.arc_start.tolist(),
+        chains.arc_end.tolist(),
+        around.patch.tolist(),
+    )
     for a in range(chains.n_arcs):
-        chain = chains.chain_vertices[chains.chain_offsets[a] : chains.chain_offsets[a + 1]]
-        members = around.patch[around.offsets[a] : around.offsets[a + 1]]
+        chain = chains.chain_vertices[bounds[a] : bounds[a + 1]]
         arc_list.append(
-            Arc(
+            Arc.model_construct(
                 id=a,
-                points=soup.vertices[chain],
-                start=int(chains.arc_start[a]),
-                end=int(chains.arc_end[a]),
-                patches=tuple(int(p) for p in members),
+                points=as_readonly(soup.vertices[chain]),
+                start=starts[a],
+                end=ends[a],
+                patches=tuple(members[offsets[a] : offsets[a + 1]]),
             )
         )
     counts = split.patch_triangle_counts()
@@ -189,7 +209,7 @@ def _topology(
         surface = soup.surfaces[index]
         label = int(split.patch_label[patch])
         patches.append(
-            Patch(
+            Patch.model_construct(
                 id=patch,
                 surface=int(surface.id or 0),
                 label=label,

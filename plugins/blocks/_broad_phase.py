@@ -241,11 +241,11 @@ def _spread_rows(
     Offset codes of large triangles are 0 (their pairs are deduplicated instead)."""
     spread, first, past = boxes
     big = large[spread]
-    box, key, code = grid.cells(first[:, ~big], past[:, ~big])
-    box = spread[~big][box]
+    small, small_first, small_past = spread[~big], first[:, ~big], past[:, ~big]
     wide = spread[big]
     if wide.size == 0:
-        return box, key, code
+        box, key, code = grid.cells(small_first, small_past)
+        return small[box], key, code
     coarse = grid.coarser(_COARSE)
     shift = _COARSE.bit_length() - 1
     low = first[:, big] >> shift
@@ -255,15 +255,29 @@ def _spread_rows(
     lowest = _block_extremes(around[0], _COARSE, lowest=True)
     highest = _block_extremes(around[1], _COARSE, lowest=False)
     wanted = (lowest[c_key] < group) | (highest[c_key] > group)
-    if box.size:
+    kept = np.arange(small.shape[0])
+    if small.size:
         # The other spread boxes enter every cell they reach, which may lie two cells past
-        # their first (beyond ``around``): the blocks of those cells, by group.
-        block = coarse.keys(grid.index(key) >> shift)
+        # their first (beyond ``around``): the blocks of those cells, by group. The blocks of
+        # a box's cells are the blocks of its range of blocks, listed as such (a few rows per
+        # box, not one per cell, and no cell indices divided out of the keys).
+        b_low = small_first >> shift
+        b_row, block, _ = coarse.cells(b_low, ((small_first + small_past) >> shift) - b_low)
+        b_group = groups[small[b_row]]
         spread_low = np.full(coarse.n_cells, np.iinfo(groups.dtype).max, dtype=groups.dtype)
         spread_high = np.zeros(coarse.n_cells, dtype=groups.dtype)
-        np.minimum.at(spread_low, block, groups[box])
-        np.maximum.at(spread_high, block, groups[box])
+        np.minimum.at(spread_low, block, b_group)
+        np.maximum.at(spread_high, block, b_group)
         wanted |= (spread_low[c_key] < group) | (spread_high[c_key] > group)
+        kept = _not_alone(
+            coarse,
+            (np.minimum(lowest, spread_low), np.maximum(highest, spread_high)),
+            (c_key, group),
+            (b_row, block, b_group),
+            small.shape[0],
+        )
+    box, key, code = grid.cells(small_first[:, kept], small_past[:, kept])
+    box = small[kept][box]
     # Blocks that large triangles of two groups reach, then come near: a fine cell a triangle
     # comes near lies in a block it comes near (the cell grown by the margin lies in its block
     # grown by the margin), so only those blocks' cells can pair the two.
@@ -292,6 +306,35 @@ def _spread_rows(
         np.concatenate([key, f_key]),
         np.concatenate([code, np.zeros(f_key.shape[0], dtype=np.int64)]),
     )
+
+
+def _not_alone(
+    coarse: _Grid,
+    extremes: tuple[NDArray[Any], NDArray[Any]],
+    large_blocks: tuple[IntArray, NDArray[np.integer]],
+    rows: tuple[IntArray, IntArray, NDArray[np.integer]],
+    n_boxes: int,
+) -> IntArray:
+    """The spread boxes (not large) that another group may meet: those with a block of their
+    range (``rows``: box, block key, group) within two blocks of which some box of another
+    group has its first cell or a cell it may enter. ``extremes``: the least and greatest group
+    per block of the first cells (the 3 x 3 x 3 cells around them) and of the spread boxes'
+    ranges; ``large_blocks``: the blocks of the large triangles' ranges, by group.
+
+    A box left out has rows only in cells the broad phase would find not mixed, and keeping
+    them would mix none: every box near such a cell (its first cell, or a cell it enters, one
+    cell from it or from a cell one cell from it) lies within two blocks, all of its group.
+    Its rows would be dropped with the cells that are not mixed; the others are unchanged."""
+    dims = tuple(coarse.dims.tolist())
+    lowest, highest = extremes[0].copy(), extremes[1].copy()
+    c_key, group = large_blocks
+    np.minimum.at(lowest, c_key, group)
+    np.maximum.at(highest, c_key, group)
+    lowest = _dilated(_dilated(lowest.reshape(dims), np.minimum), np.minimum).reshape(-1)
+    highest = _dilated(_dilated(highest.reshape(dims), np.maximum), np.maximum).reshape(-1)
+    b_row, block, b_group = rows
+    shared = (lowest[block] != b_group) | (highest[block] != b_group)
+    return np.flatnonzero(np.bincount(b_row[shared], minlength=n_boxes) > 0)
 
 
 def _near_other_groups(
@@ -325,10 +368,7 @@ def _near_other_groups(
         mixed = (
             _dilated(lowest.reshape(dims), np.minimum) < _dilated(highest.reshape(dims), np.maximum)
         ).reshape(-1)
-        near = mixed[lower]
-        near[spread] = False
-        near[box[mixed[key]]] = True
-        return near, box, key, code
+        return _near_and_rows(mixed, lower, spread, (box, key, code))
     lowest = np.full(grid.n_cells, maximum, dtype=groups.dtype)
     highest = np.zeros(grid.n_cells, dtype=groups.dtype)
     np.minimum.at(lowest, lower, groups)
@@ -351,9 +391,27 @@ def _near_other_groups(
             np.maximum(around[1], _dilated(highest.reshape(dims), np.maximum)),
         )
     mixed = (around[0] < around[1]).reshape(-1)
+    return _near_and_rows(mixed, lower, spread, (box, key, code))
+
+
+def _near_and_rows(
+    mixed: BoolArray, lower: IntArray, spread: IntArray, rows: tuple[IntArray, IntArray, IntArray]
+) -> tuple[BoolArray, IntArray, IntArray, IntArray]:
+    """Which boxes are near another group's (``mixed``: the cells with two groups' boxes in
+    the 3 x 3 x 3 around them, ``lower``: every box's first cell, ``spread``: the spread boxes)
+    and the spread boxes' ``rows`` (box, cell key, code) in mixed cells only.
+
+    A row in a cell that is not mixed can never pair: a cell pairs boxes of two groups that
+    have rows there, and every row of a box lies in its first cell or in one of the 3 x 3 x 3
+    around it (a compact box) or is one of the spread rows (whose cells ``mixed`` counts), so
+    two groups with rows in a cell make it mixed. Such rows would be dropped with the cells
+    that only one group reaches; they are dropped here, before they are gathered again."""
+    box, key, code = rows
     near = mixed[lower]
     near[spread] = False
-    near[box[mixed[key]]] = True
+    live = mixed[key]
+    box, key, code = box[live], key[live], code[live]
+    near[box] = True
     return near, box, key, code
 
 

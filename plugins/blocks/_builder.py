@@ -141,7 +141,15 @@ def build_blocks(scene: Scene, options: BlockBuilderOptions) -> Scene:
     )
     built = assembly.scene
     metadata = {**built.metadata, REPORT_KEY: report.model_dump(mode="json")}
-    return built.replace(metadata=metadata)
+    # Only the metadata changes: the validated parts are not validated again.
+    return Scene.from_validated(
+        entities=built.entities,
+        groups=built.groups,
+        crs=built.crs,
+        topology=built.topology,
+        name=built.name,
+        metadata=metadata,
+    )
 
 
 @dataclass(frozen=True)

@@ -418,7 +418,7 @@ def _crossings(
     """Crossings and T-junctions between triangles of different surfaces; ``pairs``: the
     candidate pairs when the caller's broad phase (a wider margin) already found them (only
     their triangles are gathered then)."""
-    local = soup.local(soup.vertices)
+    local = soup.local_vertices
     i, j = stored_pairs(soup.corners, soup.triangle_surface, margin=tol) if pairs is None else pairs
     if i.size == 0:
         return []
@@ -574,7 +574,7 @@ def _gaps(
     border, points, owner = free
     if border.shape[0] == 0 or gap_tolerance <= 0.0:
         return []
-    local = soup.local(soup.vertices)
+    local = soup.local_vertices
     n_points = points.shape[0]
     if pairs is None:
         dots = np.repeat(local[points][:, None, :], 3, axis=1)
@@ -651,7 +651,7 @@ def find_defects(soup: Soup, split: PatchSplit | None, gap_tolerance: float) -> 
     if border.shape[0] == 0 or gap_tolerance <= 0.0:
         return _crossings(soup, tol) + _gaps(soup, free, gap_tolerance, tol)
     n = soup.n_triangles
-    columns = np.ascontiguousarray(soup.local(soup.vertices).T)
+    columns = np.ascontiguousarray(soup.local_vertices.T)
     stored = np.empty((3, 3, n + points.shape[0]))  # component-major: (corner, xyz, K)
     for corner in range(3):  # 1-D gathers: numpy's fancy indexing of rows is slower
         index = np.ascontiguousarray(soup.triangles[:, corner])

@@ -64,7 +64,7 @@ def describe_dangling(
     if patches.size == 0:
         return []
     counts = np.bincount(split.triangle_patch, minlength=split.n_patches)
-    corners = soup.local(soup.vertices)[soup.triangles]
+    corners = soup.local_vertices[soup.triangles]
     centroids = corners.mean(axis=1)
     sums = group_sums(split.triangle_patch, centroids, split.n_patches)
     result = []

@@ -63,10 +63,18 @@ class Soup:
         )
 
     @cached_property
+    def local_vertices(self) -> FloatArray:
+        """The vertices relative to the model centre (:meth:`local`), read-only — computed once
+        for the stages that need them (contact and gap search, patch measures, the universe)."""
+        local = self.local(self.vertices)
+        local.flags.writeable = False
+        return local
+
+    @cached_property
     def corners(self) -> FloatArray:
         """Model-centred corners of the triangles, component-major: (corner, xyz, T) — gathered
         once for the stages that need them (contact search, patch measures)."""
-        return component_major(np.ascontiguousarray(self.local(self.vertices).T), self.triangles)
+        return component_major(np.ascontiguousarray(self.local_vertices.T), self.triangles)
 
     def surface_name(self, index: int) -> str:
         surface = self.surfaces[index]

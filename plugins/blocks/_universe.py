@@ -85,7 +85,7 @@ def _region_triangles(
     triangles = soup.triangles[keep]
     flip = on_positive[keep]
     triangles[flip] = triangles[flip][:, ::-1]
-    local = soup.local(soup.vertices)
+    local = soup.local_vertices
     return local[triangles[:, 0]], local[triangles[:, 1]], local[triangles[:, 2]]
 
 

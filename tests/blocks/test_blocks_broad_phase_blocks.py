@@ -78,3 +78,35 @@ def test_spread_box_two_cells_past_its_first(monkeypatch: pytest.MonkeyPatch) ->
     )
     assert (224, 375) in direct
     assert direct == blocked
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_spread_boxes_far_from_other_groups(monkeypatch: pytest.MonkeyPatch, seed: int) -> None:
+    # Groups in bands along x: spread boxes inside a band, two blocks away from any other
+    # group, are left out of the blocks path (their cells are never mixed); the pairs are
+    # those of listing every cell.
+    rng = np.random.default_rng(seed)
+    n = 3000
+    centres = rng.uniform(0, 20, (n, 1, 3)) * [5.0, 1.0, 1.0]
+    r = rng.random((n, 1, 1))
+    scale = np.where(r < 0.03, 6.0, np.where(r < 0.3, 1.5, 0.25))
+    corners = centres + scale * rng.normal(size=(n, 3, 3))
+    groups = np.clip((centres[:, 0, 0] / 100.0 * 4).astype(int), 0, 3)
+    order = np.argsort(groups, kind="stable")
+    corners, groups = corners[order], groups[order]
+    left_out = []
+    not_alone = _broad_phase._not_alone
+
+    def spy(*args: object) -> np.ndarray:
+        kept = not_alone(*args)  # type: ignore[arg-type]
+        left_out.append(int(args[-1]) - kept.size)  # type: ignore[call-overload]
+        return kept
+
+    monkeypatch.setattr(_broad_phase, "_not_alone", spy)
+    for margin in (1e-3, 0.5):
+        direct, blocked = both_ways(
+            monkeypatch, lambda m=margin: overlapping_pairs(corners, groups, m)
+        )
+        assert direct == blocked
+        assert any(groups[a] != groups[b] for a, b in direct)
+    assert sum(left_out) > 0
