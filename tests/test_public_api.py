@@ -221,7 +221,8 @@ print(json.dumps(sorted(sys.modules)))
 #: What reading a small TSurf must not import: any plugin but GOCAD's (the others are declared,
 #: geobrep.host._declared, and imported on first use), meshio, scipy and pyproj (no merge, no
 #: graph, no reprojection), nor the GOCAD readers of other object types (Model3d, grids, wells)
-#: or the GOCAD writer.
+#: or the GOCAD writer, nor the models of entities a TSurf does not hold (grids, wells,
+#: tetrahedral meshes, NURBS, octrees, polygons, annotations).
 NOT_FOR_A_TSURF = (
     "scipy",
     "pyproj",
@@ -238,6 +239,13 @@ NOT_FOR_A_TSURF = (
     "geobrep.adapters.gocad._well",
     "geobrep.adapters.gocad._writer",
     "geobrep.gis.crs_ops",
+    *(
+        f"geobrep.model.entities.{module}"
+        for module in (
+            *("annotation", "grid", "nurbs", "octree"),
+            *("polygon", "structured", "tetmesh", "well"),
+        )
+    ),
 )
 
 

@@ -34,7 +34,7 @@ from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.errors import EntityValidationError, FormatError, TopologyError
 from geobrep.host.capabilities import SKIPPED_ON_READ
 from geobrep.model.crs import CRS
-from geobrep.model.entities import Entity, PointSet, PolyLine, Surface, TetMesh
+from geobrep.model.entities import Entity, PointSet, PolyLine, Surface
 from geobrep.model.orientation import orient_blocks
 from geobrep.model.properties import Property
 from geobrep.model.scene import Group, Scene
@@ -561,6 +561,8 @@ class _Builder:
                     "kept in metadata['gocad']['ctetra_regions']",
                     obj.line,
                 )
+        from geobrep.model.entities.tetmesh import TetMesh
+
         tet_id = self.next_id()
         self.entities.append(
             TetMesh(
