@@ -221,7 +221,8 @@ print(json.dumps(sorted(sys.modules)))
 #: What reading a small TSurf must not import: any plugin but GOCAD's (the others are declared,
 #: geobrep.host._declared, and imported on first use), meshio, scipy and pyproj (no merge, no
 #: graph, no reprojection), nor the GOCAD readers of other object types (Model3d, grids, wells)
-#: or the GOCAD writer, nor the models of entities a TSurf does not hold (grids, wells,
+#: or the GOCAD writer, nor the records of a Model3d header or TSolid MODEL section (their
+#: dataclasses), nor the models of entities a TSurf does not hold (grids, wells,
 #: tetrahedral meshes, NURBS, octrees, polygons, annotations).
 NOT_FOR_A_TSURF = (
     "scipy",
@@ -234,6 +235,7 @@ NOT_FOR_A_TSURF = (
     "geobrep.plugins.voxelize",
     *(module for name, (module, _) in BUILTIN_PLUGINS.items() if name != "gocad"),
     "geobrep.adapters.gocad._model3d",
+    "geobrep.adapters.gocad._model_records",
     "geobrep.adapters.gocad._voxet",
     "geobrep.adapters.gocad._sgrid",
     "geobrep.adapters.gocad._well",
@@ -279,7 +281,11 @@ def test_reading_a_tsurf_imports_only_what_it_needs() -> None:
 #: meshio, and the command line's modules (argparse: the operation registry builds parsers only
 #: for the command line).
 NOT_FOR_A_MODEL3D = (
-    *(name for name in NOT_FOR_A_TSURF if name != "geobrep.adapters.gocad._model3d"),
+    *(
+        name
+        for name in NOT_FOR_A_TSURF
+        if name not in ("geobrep.adapters.gocad._model3d", "geobrep.adapters.gocad._model_records")
+    ),
     "geobrep.cli",
     "geobrep.batch",
     "argparse",

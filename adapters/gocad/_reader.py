@@ -27,7 +27,7 @@ from geobrep.adapters.gocad._headers import PropertyHeader, color_from_text
 from geobrep.adapters.gocad._lexer import Source
 from geobrep.adapters.gocad._objects import gocad_section
 from geobrep.adapters.gocad._parser import GROUP_TYPES, GocadObject, GocadWarning, parse_source
-from geobrep.adapters.gocad._records import CrsBlock, ErrorFactory, SolidSurface
+from geobrep.adapters.gocad._records import CrsBlock, ErrorFactory
 from geobrep.adapters.gocad._regions import TetFaces, root_vertices
 from geobrep.adapters.gocad._tables import IdLookup, ResolvedVertices
 from geobrep.adapters.gocad.options import GocadOptions
@@ -39,7 +39,8 @@ from geobrep.model.orientation import orient_blocks
 from geobrep.model.properties import Property
 from geobrep.model.scene import Group, Scene
 
-if TYPE_CHECKING:  # a Model3d read only
+if TYPE_CHECKING:
+    from geobrep.adapters.gocad._model_records import SolidSurface  # a TSolid read only
     from geobrep.model.arcs import JoinedPatches
 
 __all__ = ["FLAG_PROPERTY", "GocadReadOptions", "crs_from_block", "read_gocad"]
