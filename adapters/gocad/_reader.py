@@ -35,7 +35,6 @@ from geobrep.errors import EntityValidationError, FormatError, TopologyError
 from geobrep.host.capabilities import SKIPPED_ON_READ
 from geobrep.model.crs import CRS
 from geobrep.model.entities import Entity, PointSet, PolyLine, Surface
-from geobrep.model.orientation import orient_blocks
 from geobrep.model.properties import Property
 from geobrep.model.scene import Group, Scene
 
@@ -218,6 +217,8 @@ class _Builder:
 
     def _orient_blocks(self, scene: Scene, joined: JoinedPatches | None) -> Scene:
         """REGION sides reversed where the geometry contradicts them (one warning each)."""
+        from geobrep.model.orientation import orient_blocks  # a model with blocks only
+
         try:
             scene, notes = orient_blocks(scene, joined)
         except TopologyError as exc:

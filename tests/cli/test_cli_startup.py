@@ -75,6 +75,7 @@ NOT_FOR_INFO = (
     *(module for name, (module, _) in BUILTIN_PLUGINS.items() if name != "gocad"),
     "geobrep.adapters.gocad._model3d",
     "geobrep.adapters.gocad._model_records",
+    "geobrep.model.arcs",
     "geobrep.adapters.gocad._voxet",
     "geobrep.adapters.gocad._sgrid",
     "geobrep.adapters.gocad._well",
