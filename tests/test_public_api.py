@@ -221,7 +221,9 @@ print(json.dumps(sorted(sys.modules)))
 #: What reading a small TSurf must not import: any plugin but GOCAD's (the others are declared,
 #: geobrep.host._declared, and imported on first use), meshio, scipy and pyproj (no merge, no
 #: graph, no reprojection), nor the GOCAD readers of other object types (Model3d, grids, wells)
-#: or the GOCAD writer.
+#: or the GOCAD writer, nor the records of a Model3d header or TSolid MODEL section (their
+#: dataclasses) or the rebuilding of corners and arcs, nor the models of entities a TSurf does
+#: not hold (grids, wells, tetrahedral meshes, NURBS, octrees, polygons, annotations).
 NOT_FOR_A_TSURF = (
     "scipy",
     "pyproj",
@@ -233,11 +235,20 @@ NOT_FOR_A_TSURF = (
     "geobrep.plugins.voxelize",
     *(module for name, (module, _) in BUILTIN_PLUGINS.items() if name != "gocad"),
     "geobrep.adapters.gocad._model3d",
+    "geobrep.adapters.gocad._model_records",
+    "geobrep.model.arcs",
     "geobrep.adapters.gocad._voxet",
     "geobrep.adapters.gocad._sgrid",
     "geobrep.adapters.gocad._well",
     "geobrep.adapters.gocad._writer",
     "geobrep.gis.crs_ops",
+    *(
+        f"geobrep.model.entities.{module}"
+        for module in (
+            *("annotation", "grid", "nurbs", "octree"),
+            *("polygon", "structured", "tetmesh", "well"),
+        )
+    ),
 )
 
 
@@ -269,9 +280,14 @@ def test_reading_a_tsurf_imports_only_what_it_needs() -> None:
 #: What reading a Model3d must not import: the plugins (its blocks are built from its regions by
 #: the model, not by the blocks plugin), the other GOCAD readers and the writer, scipy, pyproj,
 #: meshio, and the command line's modules (argparse: the operation registry builds parsers only
-#: for the command line).
+#: for the command line). It loads its own, _MODEL3D_ONLY.
+_MODEL3D_ONLY = (
+    "geobrep.adapters.gocad._model3d",
+    "geobrep.adapters.gocad._model_records",
+    "geobrep.model.arcs",
+)
 NOT_FOR_A_MODEL3D = (
-    *(name for name in NOT_FOR_A_TSURF if name != "geobrep.adapters.gocad._model3d"),
+    *(name for name in NOT_FOR_A_TSURF if name not in _MODEL3D_ONLY),
     "geobrep.cli",
     "geobrep.batch",
     "argparse",

@@ -695,3 +695,105 @@ class TestFromValidated:
             crs="EPSG:32633",  # type: ignore[arg-type]
         )
         assert scene == Scene(entities=[wells()], topology={"patches": []}, crs="EPSG:32633")
+
+
+# ----------------------------------------------------------------------------- lazy entity types
+#: The entity modules a surface file does not need: imported on first use of their classes.
+LAZY_ENTITY_MODULES = tuple(
+    f"geobrep.model.entities.{m}"
+    for m in ("annotation", "grid", "nurbs", "octree", "polygon", "structured", "tetmesh", "well")
+)
+
+
+def _in_a_fresh_interpreter(code: str) -> Any:
+    import json
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout.splitlines()[-1])
+
+
+class TestLazyEntityTypes:
+    """The entity modules a file does not need are imported when a scene is first validated
+    (its schema names every type) or a class is named, not with the package."""
+
+    def test_every_entity_type_is_in_the_scene_union(self) -> None:
+        from typing import get_args
+
+        from geobrep.model import entities
+
+        union = get_args(get_args(entities.AnyEntity)[0])
+        assert [c.__name__ for c in union] == list(entities.ENTITY_MODULES)
+        assert {c.__name__: c for c in union} == entities.ENTITY_TYPES
+        for name, module in entities.ENTITY_MODULES.items():
+            cls = getattr(entities, name)
+            assert cls.__module__ == f"geobrep.model.entities.{module}"
+            assert entities.is_entity_class(cls)
+        assert not entities.is_entity_class(entities.VertexEntity)
+        assert not entities.is_entity_class(type("Surface", (Surface,), {}))
+
+    def test_a_surface_scene_loads_no_other_entity_module(self) -> None:
+        code = (
+            "import json, sys\n"
+            "from geobrep import Scene, Surface\n"
+            "tri = Surface(vertices=[[0, 0, 0], [1, 0, 0], [0, 1, 0]], faces=[[0, 1, 2]])\n"
+            "scene = Scene.from_validated(entities=[tri])\n"
+            "before = sorted(m for m in sys.modules if m.startswith('geobrep.model.entities.'))\n"
+            "Scene(entities=[{'type': 'PointSet', 'vertices': [[0, 0, 0]]}])\n"
+            "after = sorted(m for m in sys.modules if m.startswith('geobrep.model.entities.'))\n"
+            "print(json.dumps([scene.entities[0].id, before, after]))\n"
+        )
+        ident, before, after = _in_a_fresh_interpreter(code)
+        assert ident == 0
+        assert not [m for m in before if m in LAZY_ENTITY_MODULES]
+        assert set(LAZY_ENTITY_MODULES) <= set(after)  # the scene's schema was built
+
+    def test_a_fresh_scene_validates_every_type_by_its_tag(self) -> None:
+        code = (
+            "import json\n"
+            "from geobrep import Scene\n"
+            "try:\n"
+            "    Scene(entities=[{'type': 'Nope'}])\n"
+            "except Exception as exc:\n"
+            "    message = str(exc)\n"
+            "octree = {'type': 'LinearOctree', 'depth': 2, 'origin': [0, 0, 0], 'size': 4.0,\n"
+            "          'codes': [0], 'levels': [0]}\n"
+            "scene = Scene(entities=[octree])\n"
+            "print(json.dumps([message, type(scene.entities[0]).__name__]))\n"
+        )
+        message, kind = _in_a_fresh_interpreter(code)
+        assert kind == "LinearOctree"
+        tags = ", ".join(f"'{name}'" for name in geobrep.model.entities.ENTITY_MODULES)
+        assert message == (
+            "Scene: entities.0: Input tag 'Nope' found using 'type' does not match any of the "
+            f"expected tags: {tags}"
+        )
+
+    def test_from_validated_takes_entities_of_every_type_as_they_are(
+        self, monkeypatch: pytest.MonkeyPatch
+    ) -> None:
+        net = np.zeros((2, 2, 3))
+        net[1, :, 0] = 1.0
+        net[:, 1, 1] = 1.0
+        nurbs = geobrep.NurbsSurface(
+            degree_u=1, degree_v=1, knots_u=[0, 0, 1, 1], knots_v=[0, 0, 1, 1], control_points=net
+        )
+        octree = geobrep.LinearOctree(depth=2, origin=[0, 0, 0], size=4.0, codes=[0], levels=[0])
+        cake = geobrep.datasets.faulted_layer_cake()
+        parts = [*cake.entities, nurbs, octree]
+
+        def constructor(self: Scene, **data: Any) -> None:
+            raise AssertionError("validated entities were validated again")
+
+        built = Scene(entities=parts, topology=cake.topology)
+        monkeypatch.setattr(Scene, "__init__", constructor)
+        assembled = Scene.from_validated(entities=parts, topology=cake.topology)
+        assert assembled.entities == built.entities
+        assert [type(e) for e in assembled.entities] == [type(e) for e in parts]
+        other = type("Surface", (Surface,), {})(vertices=TRIANGLE, faces=[[0, 1, 2]])
+        with pytest.raises(AssertionError, match="validated again"):  # not one of the classes
+            Scene.from_validated(entities=[other])

@@ -8,19 +8,23 @@ is imported when a file of its type is read or written (a .ts read loads none of
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from geobrep.adapters.gocad._lexer import split_tokens
 from geobrep.errors import FormatError
-from geobrep.model.entities import Entity, RegularGrid, StructuredGrid, Well
 from geobrep.model.scene import Scene
+
+if TYPE_CHECKING:
+    from geobrep.model.entities import RegularGrid, StructuredGrid
 
 __all__ = ["GRID_OBJECTS", "object_type_of", "read_grid_object", "write_grid_object"]
 
-#: Object type → the extension it is written with and the entity type it holds.
-GRID_OBJECTS: dict[str, tuple[str, type[Entity]]] = {
-    "Voxet": (".vo", RegularGrid),
-    "SGrid": (".sg", StructuredGrid),
-    "Well": (".wl", Well),
+#: Object type → the extension it is written with and the name of the entity type it holds
+#: (a class of :mod:`geobrep.model.entities`, imported when such an object is written).
+GRID_OBJECTS: dict[str, tuple[str, str]] = {
+    "Voxet": (".vo", "RegularGrid"),
+    "SGrid": (".sg", "StructuredGrid"),
+    "Well": (".wl", "Well"),
 }
 _BY_SUFFIX = {suffix: name for name, (suffix, _) in GRID_OBJECTS.items()}
 
@@ -72,8 +76,11 @@ def grid_object_for(path: Path, object_type: str | None) -> str | None:
 def write_grid_object(scene: Scene, path: Path, object_type: str, ascii_data: bool = False) -> None:
     """Write the scene's one entity of the object type's entity class."""
     from geobrep.adapters.gocad._objects import report
+    from geobrep.model import entities
+    from geobrep.model.entities import RegularGrid, StructuredGrid, Well
 
-    _, wanted = GRID_OBJECTS[object_type]
+    _, name = GRID_OBJECTS[object_type]
+    wanted = getattr(entities, name)
     chosen = [e for e in scene.entities if isinstance(e, wanted)]
     if not chosen:
         raise FormatError(f"the scene has no {wanted.__name__} to write as {object_type}", path)

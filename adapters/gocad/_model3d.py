@@ -19,15 +19,15 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from geobrep.adapters.gocad._objects import gocad_section
-from geobrep.adapters.gocad._parser import GocadObject
-from geobrep.adapters.gocad._records import (
-    Diagnostics,
+from geobrep.adapters.gocad._model_records import (
     Model3dHeader,
     ModelList,
     RegionEntry,
     TFaceEntry,
 )
+from geobrep.adapters.gocad._objects import gocad_section
+from geobrep.adapters.gocad._parser import GocadObject
+from geobrep.adapters.gocad._records import Diagnostics
 from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.geometry.bbox import column_extremes
 from geobrep.model.arcs import JoinedPatches, corners_and_arcs_of

@@ -14,6 +14,7 @@ import re
 import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -42,16 +43,6 @@ from geobrep.adapters.gocad._records import (
     CrsBlock,
     CTetra,
     Geology,
-    KeyVertices,
-    Model3dHeader,
-    ModelList,
-    ModelRegion,
-    RegionEntry,
-    SolidModel,
-    SolidSurface,
-    SolidTFace,
-    SolidTriangle,
-    TFaceEntry,
 )
 from geobrep.adapters.gocad._tables import (
     CellTable,
@@ -62,6 +53,16 @@ from geobrep.adapters.gocad._tables import (
 from geobrep.adapters.limits import human_bytes, read_budget
 from geobrep.errors import FormatError
 from geobrep.model.entities import Entity
+
+if TYPE_CHECKING:  # made for a Model3d, TSolid or LightTSolid object only
+    from geobrep.adapters.gocad._model_records import (
+        ListDraft,
+        Model3dHeader,
+        ModelDraft,
+        SolidDraft,
+        SolidModel,
+        SolidTFaceDraft,
+    )
 
 __all__ = ["GocadObject", "GocadWarning", "parse_source"]
 
@@ -137,12 +138,30 @@ class GocadObject:
     bstones: list[BStone] = field(default_factory=list)
     borders: list[Border] = field(default_factory=list)
     ctetra: list[CTetra] = field(default_factory=list)
-    model3d: Model3dHeader = field(default_factory=Model3dHeader)
-    solid_model: SolidModel = field(default_factory=SolidModel)
+    header_of_model: Model3dHeader | None = None  # a Model3d's (see model3d)
+    model_of_solid: SolidModel | None = None  # a TSolid's MODEL section (see solid_model)
     member_type: str | None = None  # a group's TYPE line
     members: list[GocadObject] = field(default_factory=list)
     extra_lines: list[str] = field(default_factory=list)
     grid: Entity | None = None  # a Voxet, SGrid or Well member, read by its own reader
+
+    @property
+    def model3d(self) -> Model3dHeader:
+        """What a Model3d's header declares (an empty header for other objects)."""
+        if self.header_of_model is None:
+            from geobrep.adapters.gocad._model_records import Model3dHeader
+
+            self.header_of_model = Model3dHeader()
+        return self.header_of_model
+
+    @property
+    def solid_model(self) -> SolidModel:
+        """A TSolid's MODEL section (an empty one for other objects)."""
+        if self.model_of_solid is None:
+            from geobrep.adapters.gocad._model_records import SolidModel
+
+            self.model_of_solid = SolidModel()
+        return self.model_of_solid
 
     @property
     def name(self) -> str:
@@ -156,81 +175,6 @@ class GocadObject:
             if k == key:
                 return value
         return None
-
-
-@dataclass
-class _TFaceDraft:
-    id: int
-    type: str
-    tsurf: str
-    line: int
-    key: list[tuple[float, float, float]] = field(default_factory=list)
-
-
-@dataclass
-class _ListDraft:
-    keyword: str
-    name: str
-    line: int
-    region_id: int | None = None  # REGION only
-    items: list[int] = field(default_factory=list)
-    closed: bool = False  # the list's 0 was read
-
-
-@dataclass
-class _Model3dDraft:
-    """A Model3d header while its lines are read; :meth:`freeze` gives the record."""
-
-    tsurfs: list[str] = field(default_factory=list)
-    tfaces: list[_TFaceDraft] = field(default_factory=list)
-    lists: list[_ListDraft] = field(default_factory=list)
-    key_for: _TFaceDraft | None = None  # the TFACE whose key-triangle lines may follow
-    current: _ListDraft | None = None  # the list whose ids may follow
-
-    def freeze(self) -> Model3dHeader:
-        return Model3dHeader(
-            tsurfs=tuple(self.tsurfs),
-            tfaces=tuple(
-                TFaceEntry(t.id, t.type, t.tsurf, tuple(t.key), t.line) for t in self.tfaces
-            ),
-            regions=tuple(
-                RegionEntry(d.region_id, d.name, tuple(d.items), d.line)
-                for d in self.lists
-                if d.keyword == "REGION" and d.region_id is not None
-            ),
-            lists=tuple(
-                ModelList(d.keyword, d.name, tuple(d.items), d.line)
-                for d in self.lists
-                if d.keyword != "REGION"
-            ),
-        )
-
-
-@dataclass
-class _SolidTFaceDraft:
-    id: int
-    key: KeyVertices | None = None
-    triangles: list[SolidTriangle] = field(default_factory=list)
-
-
-@dataclass
-class _SolidDraft:
-    """A TSolid's MODEL section while its lines are read; :meth:`freeze` gives the record."""
-
-    in_model: bool = False
-    surfaces: list[tuple[str, list[_SolidTFaceDraft]]] = field(default_factory=list)
-    regions: list[ModelRegion] = field(default_factory=list)
-
-    def freeze(self) -> SolidModel:
-        return SolidModel(
-            surfaces=tuple(
-                SolidSurface(
-                    name, tuple(SolidTFace(t.id, t.key, tuple(t.triangles)) for t in tfaces)
-                )
-                for name, tfaces in self.surfaces
-            ),
-            regions=tuple(self.regions),
-        )
 
 
 class _Stream:
@@ -507,8 +451,16 @@ class _Parser:
         vertices: VertexTable | None = None
         cells: CellTable | None = None
         part = -1
-        header = _Model3dDraft()
-        solid = _SolidDraft()
+        header: ModelDraft | None = None
+        solid: SolidDraft | None = None
+        if obj.type == "Model3d":
+            from geobrep.adapters.gocad._model_records import ModelDraft
+
+            header = ModelDraft()
+        elif obj.type in ("TSolid", "LightTSolid"):
+            from geobrep.adapters.gocad._model_records import SolidDraft
+
+            solid = SolidDraft()
         while True:
             item = self.stream.peek()
             if item is None:
@@ -528,7 +480,7 @@ class _Parser:
             keyword = _keyword(item.text)
             if keyword == "END":
                 break
-            if obj.type == "Model3d":
+            if header is not None:  # a Model3d
                 if not self._common(obj, item):
                     self._model3d_entry(obj, item, keyword, header)
                 continue
@@ -553,15 +505,16 @@ class _Parser:
                 self.warn(f"{keyword} after the object's data lines", item.number)
                 continue
             part = self._element_line(obj, item, keyword, vertices, cells, part, solid)
-        if obj.type == "Model3d":
-            obj.model3d = self._finish_model3d(header)
+        if header is not None:
+            obj.header_of_model = self._finish_model3d(header)
             return
         if vertices is None:
             vertices, cells = self._tables(obj)
         self._report_nonfinite(obj)
         obj.vertices = vertices.finish(self.error)
         obj.cells = CellRows(*cells.finish()) if cells is not None else None
-        obj.solid_model = solid.freeze()
+        if solid is not None:
+            obj.model_of_solid = solid.freeze()
 
     def _tables(self, obj: GocadObject) -> tuple[VertexTable, CellTable | None]:
         """The vertex and cell tables, sized by the (now complete) property headers."""
@@ -657,7 +610,7 @@ class _Parser:
         vertices: VertexTable,
         cells: CellTable | None,
         part: int,
-        solid: _SolidDraft,
+        solid: SolidDraft | None,
     ) -> int:
         if run.keyword == "ATOM":
             return self._atom_run(obj, run, vertices, cells, part, solid)
@@ -723,7 +676,7 @@ class _Parser:
         vertices: VertexTable,
         cells: CellTable | None,
         part: int,
-        solid: _SolidDraft,
+        solid: SolidDraft | None,
     ) -> int:
         """A run of ``ATOM <new id> <id>`` lines in one bulk parse (line by line when it holds
         anything else, such as flags)."""
@@ -751,7 +704,7 @@ class _Parser:
         vertices: VertexTable,
         cells: CellTable | None,
         part: int,
-        solid: _SolidDraft,
+        solid: SolidDraft | None,
     ) -> int:
         """A run of ``PATOM <new id> <id> <values>`` lines in one bulk parse (line by line
         when it holds anything else, or no property header gives the lines values)."""
@@ -829,7 +782,7 @@ class _Parser:
         vertices: VertexTable,
         cells: CellTable | None,
         part: int,
-        solid: _SolidDraft,
+        solid: SolidDraft | None,
     ) -> None:
         for index in range(run.count):
             number = run.first + index
@@ -844,7 +797,7 @@ class _Parser:
         vertices: VertexTable,
         cells: CellTable | None,
         part: int,
-        solid: _SolidDraft,
+        solid: SolidDraft | None,
     ) -> int:
         """One line of an object's body; the part (TFACE, ILINE, ...) the next lines go to."""
         number = item.number
@@ -866,7 +819,7 @@ class _Parser:
                 self._border_line(obj, item, keyword)
             elif keyword in _SKIP_BLOCKS:
                 self._skip_block(keyword, number)
-            elif obj.type in ("TSolid", "LightTSolid"):
+            elif solid is not None:  # a TSolid or LightTSolid
                 self._tsolid_model_line(obj, item, keyword, solid)
             else:
                 self.warn(f"unknown keyword {keyword!r} in a {obj.type}; line kept", number)
@@ -929,12 +882,12 @@ class _Parser:
         keyword: str,
         vertices: VertexTable,
         part: int,
-        solid: _SolidDraft,
+        solid: SolidDraft | None,
     ) -> int:
         """``TFACE`` / ``3DFACE`` / ``ILINE`` / ``TVOLUME`` / ``SUBVSET``: a new part (a TFACE in
         a TSolid's MODEL section is one of the model's)."""
         if keyword == "SUBVSET" or obj.type in ("TSurf", "PLine", "TSolid", "LightTSolid"):
-            if obj.type in ("TSolid", "LightTSolid") and solid.in_model:
+            if solid is not None and solid.in_model:
                 self._tsolid_model_line(obj, item, keyword, solid)
                 return part
             obj.declared_parts += 1
@@ -1010,7 +963,7 @@ class _Parser:
 
     # -- TSolid model section -------------------------------------------------------------------
     def _tsolid_model_line(
-        self, obj: GocadObject, item: Line, keyword: str, solid: _SolidDraft
+        self, obj: GocadObject, item: Line, keyword: str, solid: SolidDraft
     ) -> None:
         tokens = split_tokens(item.text)
         if keyword == "MODEL":
@@ -1022,33 +975,29 @@ class _Parser:
                 raise self.error("TFACE before any SURFACE in the MODEL section", item.number)
             count = sum(len(tfaces) for _, tfaces in solid.surfaces)
             tface_id = parse_int(tokens[1]) if len(tokens) > 1 else count + 1
-            solid.surfaces[-1][1].append(_SolidTFaceDraft(tface_id))
+            solid.add_tface(tface_id)
         elif keyword in ("KEYVERTICES", "TRGL"):
             current = self._current_tface(solid, item)
             if len(tokens) < 4:
                 raise self.error(f"{keyword} needs 3 vertex ids", item.number)
             a, b, c = (parse_int(t) for t in tokens[1:4])
-            triangle = SolidTriangle((a, b, c), item.number)
-            if keyword == "TRGL":
-                current.triangles.append(triangle)
-            else:
-                current.key = triangle
+            current.add(keyword, (a, b, c), item.number)
         elif keyword == "MODEL_REGION":
             if len(tokens) < 3:
                 raise self.error("MODEL_REGION needs a name and a signed TFACE id", item.number)
-            solid.regions.append(ModelRegion(" ".join(tokens[1:-1]), parse_int(tokens[-1])))
+            solid.add_region(" ".join(tokens[1:-1]), parse_int(tokens[-1]))
         else:
             self.warn(f"unknown keyword {keyword!r} in a {obj.type}; line kept", item.number)
             obj.extra_lines.append(item.text)
 
-    def _current_tface(self, solid: _SolidDraft, item: Line) -> _SolidTFaceDraft:
+    def _current_tface(self, solid: SolidDraft, item: Line) -> SolidTFaceDraft:
         if not solid.surfaces or not solid.surfaces[-1][1]:
             raise self.error(f"{_keyword(item.text)} before any TFACE of the MODEL", item.number)
         return solid.surfaces[-1][1][-1]
 
     # -- Model3d header -------------------------------------------------------------------------
     def _model3d_entry(
-        self, obj: GocadObject, item: Line, keyword: str, header: _Model3dDraft
+        self, obj: GocadObject, item: Line, keyword: str, header: ModelDraft
     ) -> None:
         """:meth:`_model3d_line`, with a bad number named with its keyword and line."""
         try:
@@ -1058,7 +1007,7 @@ class _Parser:
                 raise
             raise self.error(f"{keyword}: {exc}", item.number) from None
 
-    def _model3d_line(self, obj: GocadObject, item: Line, header: _Model3dDraft) -> None:
+    def _model3d_line(self, obj: GocadObject, item: Line, header: ModelDraft) -> None:
         keyword = _keyword(item.text)
         text = item.text
         if keyword == "TSURF":
@@ -1077,30 +1026,31 @@ class _Parser:
             tface_id = parse_int(tokens[1])
             if tface_id < 1:
                 raise self.error(f"TFACE id {tface_id} must be a positive number", item.number)
-            entry = _TFaceDraft(tface_id, tokens[2], _unquote(tokens[3].strip()), item.number)
-            header.tfaces.append(entry)
+            entry = header.add_tface(tface_id, tokens[2], _unquote(tokens[3].strip()), item.number)
             header.key_for, header.current = entry, None
         elif keyword in _MODEL3D_LISTS:
-            header.current = self._model3d_list(keyword, item)
+            header.current = self._model3d_list(keyword, item, header)
             header.lists.append(header.current)
             header.key_for = None
         elif not self._model3d_numbers(item, header):
             self.warn(f"unknown line in the Model3d header: {text[:40]!r}; kept", item.number)
             obj.extra_lines.append(text)
 
-    def _model3d_list(self, keyword: str, item: Line) -> _ListDraft:
+    def _model3d_list(self, keyword: str, item: Line, header: ModelDraft) -> ListDraft:
         """The list a ``REGION <id> <name>`` (or ``LAYER <name>``, ...) line opens."""
         if keyword != "REGION":
-            return _ListDraft(keyword, _unquote(item.text[len(keyword) :].strip()), item.number)
+            return header.new_list(
+                keyword, _unquote(item.text[len(keyword) :].strip()), item.number
+            )
         tokens = item.text.split(None, 2)
         if len(tokens) < 3:
             raise self.error("REGION needs an id and a name", item.number)
         region_id = parse_int(tokens[1])
         if region_id < 1:
             raise self.error(f"REGION id {region_id} must be a positive number", item.number)
-        return _ListDraft(keyword, _unquote(tokens[2].strip()), item.number, region_id=region_id)
+        return header.new_list(keyword, _unquote(tokens[2].strip()), item.number, region_id)
 
-    def _model3d_numbers(self, item: Line, header: _Model3dDraft) -> bool:
+    def _model3d_numbers(self, item: Line, header: ModelDraft) -> bool:
         """A key-triangle line or a line of list ids; False when the line is neither."""
         numbers = item.text.split()
         key_for = header.key_for
@@ -1132,7 +1082,7 @@ class _Parser:
         current.items.extend(values)
         return True
 
-    def _finish_model3d(self, header: _Model3dDraft) -> Model3dHeader:
+    def _finish_model3d(self, header: ModelDraft) -> Model3dHeader:
         for entry in header.tfaces:
             if len(entry.key) != 3:
                 raise self.error(

@@ -27,19 +27,19 @@ from geobrep.adapters.gocad._headers import PropertyHeader, color_from_text
 from geobrep.adapters.gocad._lexer import Source
 from geobrep.adapters.gocad._objects import gocad_section
 from geobrep.adapters.gocad._parser import GROUP_TYPES, GocadObject, GocadWarning, parse_source
-from geobrep.adapters.gocad._records import CrsBlock, ErrorFactory, SolidSurface
+from geobrep.adapters.gocad._records import CrsBlock, ErrorFactory
 from geobrep.adapters.gocad._regions import TetFaces, root_vertices
 from geobrep.adapters.gocad._tables import IdLookup, ResolvedVertices
 from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.errors import EntityValidationError, FormatError, TopologyError
 from geobrep.host.capabilities import SKIPPED_ON_READ
 from geobrep.model.crs import CRS
-from geobrep.model.entities import Entity, PointSet, PolyLine, Surface, TetMesh
-from geobrep.model.orientation import orient_blocks
+from geobrep.model.entities import Entity, PointSet, PolyLine, Surface
 from geobrep.model.properties import Property
 from geobrep.model.scene import Group, Scene
 
-if TYPE_CHECKING:  # a Model3d read only
+if TYPE_CHECKING:
+    from geobrep.adapters.gocad._model_records import SolidSurface  # a TSolid read only
     from geobrep.model.arcs import JoinedPatches
 
 __all__ = ["FLAG_PROPERTY", "GocadReadOptions", "crs_from_block", "read_gocad"]
@@ -217,6 +217,8 @@ class _Builder:
 
     def _orient_blocks(self, scene: Scene, joined: JoinedPatches | None) -> Scene:
         """REGION sides reversed where the geometry contradicts them (one warning each)."""
+        from geobrep.model.orientation import orient_blocks  # a model with blocks only
+
         try:
             scene, notes = orient_blocks(scene, joined)
         except TopologyError as exc:
@@ -561,6 +563,8 @@ class _Builder:
                     "kept in metadata['gocad']['ctetra_regions']",
                     obj.line,
                 )
+        from geobrep.model.entities.tetmesh import TetMesh
+
         tet_id = self.next_id()
         self.entities.append(
             TetMesh(

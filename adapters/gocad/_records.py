@@ -1,13 +1,14 @@
 """Typed records the GOCAD parser hands to the reader (what a file says, before any entity).
 
-The records are frozen: the parser builds them from private drafts once an object's lines are
-read. What a reader keeps of them in ``metadata["gocad"]`` is JSON (lists, strings, numbers),
-never these types: that is stored data the native round trip and the GOCAD writer rely on.
+The records are frozen. Those of a Model3d header and a TSolid MODEL section, and the drafts
+the parser builds them from, are in :mod:`geobrep.adapters.gocad._model_records`, imported when
+a file has such an object. What a reader keeps of them in ``metadata["gocad"]`` is JSON (lists,
+strings, numbers), never these types: that is stored data the native round trip and the GOCAD
+writer rely on.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import NamedTuple, Protocol
 
 import numpy as np
@@ -24,16 +25,6 @@ __all__ = [
     "Diagnostics",
     "ErrorFactory",
     "Geology",
-    "KeyVertices",
-    "Model3dHeader",
-    "ModelList",
-    "ModelRegion",
-    "RegionEntry",
-    "SolidModel",
-    "SolidSurface",
-    "SolidTFace",
-    "SolidTriangle",
-    "TFaceEntry",
     "Warn",
 ]
 
@@ -97,91 +88,3 @@ class CellRows(NamedTuple):
     values: NDArray[np.float64]  # (M, n_values) property values
     parts: NDArray[np.int64]  # (M,) TFACE / ILINE / TVOLUME index
     lines: NDArray[np.int64]  # (M,) line numbers
-
-
-# -- Model3d header ---------------------------------------------------------------------------
-@dataclass(frozen=True)
-class TFaceEntry:
-    """``TFACE <id> <geological type> <TSurf name>`` of a Model3d header and its key triangle
-    (three coordinate lines, as written: z not yet turned by ZPOSITIVE)."""
-
-    id: int
-    type: str
-    tsurf: str
-    key: tuple[tuple[float, float, float], ...]
-    line: int
-
-
-@dataclass(frozen=True)
-class RegionEntry:
-    """``REGION <id> <name>`` and the signed TFACE ids that follow it."""
-
-    id: int
-    name: str
-    items: tuple[int, ...]
-    line: int
-
-
-@dataclass(frozen=True)
-class ModelList:
-    """``LAYER`` / ``FAULT_BLOCK`` (REGION ids) or ``SURFACE`` / ``FAULT`` / ``BOUNDARY`` /
-    ``UNIT`` (TFACE ids) of a Model3d header."""
-
-    keyword: str
-    name: str
-    items: tuple[int, ...]
-    line: int
-
-
-@dataclass(frozen=True)
-class Model3dHeader:
-    """What a Model3d object's header declares, in file order."""
-
-    tsurfs: tuple[str, ...] = ()
-    tfaces: tuple[TFaceEntry, ...] = ()
-    regions: tuple[RegionEntry, ...] = ()
-    lists: tuple[ModelList, ...] = ()
-
-
-# -- TSolid MODEL section ---------------------------------------------------------------------
-class SolidTriangle(NamedTuple):
-    """A ``TRGL`` (or ``KEYVERTICES``) line of a TSolid MODEL section: 3 vertex ids."""
-
-    ids: tuple[int, int, int]
-    line: int
-
-
-KeyVertices = SolidTriangle
-
-
-@dataclass(frozen=True)
-class SolidTFace:
-    """``TFACE <id>`` of a TSolid MODEL surface: its key triangle and triangles."""
-
-    id: int
-    key: KeyVertices | None
-    triangles: tuple[SolidTriangle, ...]
-
-
-@dataclass(frozen=True)
-class SolidSurface:
-    """``SURFACE <name>`` of a TSolid MODEL section."""
-
-    name: str
-    tfaces: tuple[SolidTFace, ...]
-
-
-@dataclass(frozen=True)
-class ModelRegion:
-    """``MODEL_REGION <name> <±tface>``: the region on that side of the TFACE's key triangle."""
-
-    name: str
-    signed_tface: int
-
-
-@dataclass(frozen=True)
-class SolidModel:
-    """The ``MODEL`` section of a TSolid / LightTSolid."""
-
-    surfaces: tuple[SolidSurface, ...] = ()
-    regions: tuple[ModelRegion, ...] = ()

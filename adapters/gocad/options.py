@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from geobrep.model.arcs import DEFAULT_RELATIVE_TOLERANCE
-
 __all__ = ["GocadOptions"]
 
 
@@ -39,6 +37,8 @@ class GocadOptions(BaseModel):
 
     def merge_tolerance_for(self, diagonal: float) -> float:
         """The joining distance for a model whose bounding-box diagonal is ``diagonal``."""
+        from geobrep.model.arcs import DEFAULT_RELATIVE_TOLERANCE  # a Model3d read's, as it is
+
         if self.merge_tolerance is not None:
             return self.merge_tolerance
         return DEFAULT_RELATIVE_TOLERANCE * (diagonal if diagonal > 0 else 1.0)

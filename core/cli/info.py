@@ -10,19 +10,7 @@ from typing import Any
 from geobrep.cli.common import add_allow_empty, format_name, is_empty, refuse_empty
 from geobrep.errors import GeobrepError
 from geobrep.model.crs import CRS
-from geobrep.model.entities import (
-    Block,
-    Entity,
-    LinearOctree,
-    NurbsSurface,
-    Polygon,
-    PolyLine,
-    RegularGrid,
-    StructuredGrid,
-    Surface,
-    TetMesh,
-    Well,
-)
+from geobrep.model.entities import Block, Entity, PointSet, PolyLine, Surface
 from geobrep.model.properties import PropertyMap
 from geobrep.model.scene import Group, Scene
 from geobrep.ops.io import read
@@ -54,6 +42,11 @@ def _properties(props: PropertyMap) -> list[dict[str, Any]]:
     ]
 
 
+#: The entity types a surface file holds, whose modules come with :mod:`geobrep.model.entities`:
+#: the others' modules are imported for an entity of none of these (its own was, to make it).
+_SURFACE_FILE_TYPES = (Surface, PolyLine, PointSet, Block)
+
+
 def _counts(entity: Entity) -> dict[str, int]:
     counts: dict[str, int] = {}
     if hasattr(entity, "vertices"):
@@ -61,28 +54,40 @@ def _counts(entity: Entity) -> dict[str, int]:
     if isinstance(entity, Surface):
         counts["faces"] = entity.n_faces
         counts["patches"] = entity.n_patches
-    elif isinstance(entity, TetMesh):
-        counts["tetrahedra"] = entity.n_cells
-        counts["regions"] = entity.n_regions
     elif isinstance(entity, PolyLine):
         counts["parts"] = entity.n_parts
         counts["segments"] = entity.n_cells
-    elif isinstance(entity, Polygon):
-        counts["polygons"] = entity.n_polygons
-        counts["rings"] = entity.n_rings
-    elif isinstance(entity, NurbsSurface):
-        counts["control_points"] = entity.n_points
-    elif isinstance(entity, LinearOctree):
-        counts["leaves"] = entity.n_leaves
     elif isinstance(entity, Block):
         counts["sides"] = len(entity.sides)
-    else:
-        counts.update(_grid_counts(entity))
+    elif not isinstance(entity, PointSet):
+        counts.update(_other_counts(entity))
     return counts
+
+
+def _other_counts(entity: Entity) -> dict[str, int]:
+    """The counts of an entity of none of :data:`_SURFACE_FILE_TYPES`."""
+    from geobrep.model.entities.nurbs import NurbsSurface
+    from geobrep.model.entities.octree import LinearOctree
+    from geobrep.model.entities.polygon import Polygon
+    from geobrep.model.entities.tetmesh import TetMesh
+
+    if isinstance(entity, TetMesh):
+        return {"tetrahedra": entity.n_cells, "regions": entity.n_regions}
+    if isinstance(entity, Polygon):
+        return {"polygons": entity.n_polygons, "rings": entity.n_rings}
+    if isinstance(entity, NurbsSurface):
+        return {"control_points": entity.n_points}
+    if isinstance(entity, LinearOctree):
+        return {"leaves": entity.n_leaves}
+    return _grid_counts(entity)
 
 
 def _grid_counts(entity: Entity) -> dict[str, int]:
     """Cells, points and well contents of the grid and well entities."""
+    from geobrep.model.entities.grid import RegularGrid
+    from geobrep.model.entities.structured import StructuredGrid
+    from geobrep.model.entities.well import Well
+
     if isinstance(entity, RegularGrid | StructuredGrid):
         ni, nj, nk = entity.counts
         counts = {"ni": ni, "nj": nj, "nk": nk, "cells": entity.n_cells}
@@ -103,6 +108,12 @@ def _grid_counts(entity: Entity) -> dict[str, int]:
 
 def _details(entity: Entity) -> dict[str, Any] | None:
     """What a user checks of a grid (its lattice) or a well (its depths and picks)."""
+    if isinstance(entity, _SURFACE_FILE_TYPES):
+        return None
+    from geobrep.model.entities.grid import RegularGrid
+    from geobrep.model.entities.structured import StructuredGrid
+    from geobrep.model.entities.well import Well
+
     if isinstance(entity, RegularGrid):
         return {
             "origin": entity.origin.tolist(),

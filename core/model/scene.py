@@ -5,18 +5,20 @@ from __future__ import annotations
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
 from functools import cache, cached_property
-from typing import Annotated, Any, Self, TypeVar, get_args
+from typing import TYPE_CHECKING, Annotated, Any, Self, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import (
     BeforeValidator,
     Field,
+    GetCoreSchemaHandler,
     JsonValue,
     TypeAdapter,
     ValidationError,
     model_validator,
 )
+from pydantic_core import CoreSchema
 
 from geobrep.errors import (
     EntityNotFoundError,
@@ -29,23 +31,21 @@ from geobrep.geometry.bbox import BoundingBox
 from geobrep.geometry.spatial_index import SpatialIndex
 from geobrep.model.base import FrozenModel
 from geobrep.model.crs import CRS, as_crs
-from geobrep.model.entities import (
-    Annotation,
-    AnyEntity,
-    Block,
-    Entity,
-    LinearOctree,
-    NurbsSurface,
-    PointSet,
-    Polygon,
-    PolyLine,
-    RegularGrid,
-    StructuredGrid,
-    Surface,
-    TetMesh,
-    Well,
-)
+from geobrep.model.entities import Block, Entity, PointSet, PolyLine, Surface, is_entity_class
 from geobrep.model.topology import Patch, Topology
+
+if TYPE_CHECKING:
+    from geobrep.model.entities import (
+        Annotation,
+        AnyEntity,
+        LinearOctree,
+        NurbsSurface,
+        Polygon,
+        RegularGrid,
+        StructuredGrid,
+        TetMesh,
+        Well,
+    )
 
 __all__ = ["STRATIGRAPHIC_COLUMN", "Group", "Scene"]
 
@@ -103,8 +103,23 @@ def _assign_ids(entities: Sequence[Any]) -> list[Any]:
     return result
 
 
-#: The entity classes a scene holds (the members of ``AnyEntity``).
-_ENTITY_CLASSES: frozenset[type] = frozenset(get_args(get_args(AnyEntity)[0]))
+class _EveryEntityType:
+    """Stands for :data:`geobrep.model.entities.AnyEntity` in the ``entities`` field: the schema
+    pydantic builds for it is that union's, built (and its entity modules imported) only when the
+    scene's own schema is, on first validation (the scene's schema is deferred). A reader's
+    scene, made by :meth:`Scene.from_validated`, imports no entity type the file does not hold.
+    """
+
+    def __get_pydantic_core_schema__(
+        self, source: Any, handler: GetCoreSchemaHandler
+    ) -> CoreSchema:
+        from geobrep.model.entities import AnyEntity
+
+        return handler.generate_schema(AnyEntity)
+
+
+if not TYPE_CHECKING:
+    AnyEntity = Annotated[Entity, _EveryEntityType()]
 
 
 @cache
@@ -173,7 +188,7 @@ class Scene(FrozenModel):
             "metadata": metadata if metadata is not None else {},
         }
         taken = (
-            all(type(e) in _ENTITY_CLASSES for e in entities)
+            all(is_entity_class(type(e)) for e in entities)
             and all(type(g) is Group for g in groups)
             and (crs is None or type(crs) is CRS)
             and type(values["topology"]) is Topology
@@ -319,34 +334,50 @@ class Scene(FrozenModel):
 
     @property
     def polygons(self) -> tuple[Polygon, ...]:
+        from geobrep.model.entities.polygon import Polygon
+
         return self.of_type(Polygon)
 
     @property
     def tet_meshes(self) -> tuple[TetMesh, ...]:
+        from geobrep.model.entities.tetmesh import TetMesh
+
         return self.of_type(TetMesh)
 
     @property
     def nurbs_surfaces(self) -> tuple[NurbsSurface, ...]:
+        from geobrep.model.entities.nurbs import NurbsSurface
+
         return self.of_type(NurbsSurface)
 
     @property
     def annotations(self) -> tuple[Annotation, ...]:
+        from geobrep.model.entities.annotation import Annotation
+
         return self.of_type(Annotation)
 
     @property
     def octrees(self) -> tuple[LinearOctree, ...]:
+        from geobrep.model.entities.octree import LinearOctree
+
         return self.of_type(LinearOctree)
 
     @property
     def regular_grids(self) -> tuple[RegularGrid, ...]:
+        from geobrep.model.entities.grid import RegularGrid
+
         return self.of_type(RegularGrid)
 
     @property
     def structured_grids(self) -> tuple[StructuredGrid, ...]:
+        from geobrep.model.entities.structured import StructuredGrid
+
         return self.of_type(StructuredGrid)
 
     @property
     def wells(self) -> tuple[Well, ...]:
+        from geobrep.model.entities.well import Well
+
         return self.of_type(Well)
 
     @property

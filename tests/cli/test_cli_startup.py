@@ -65,7 +65,8 @@ NOT_FOR_HELP = (
 )
 
 #: What describing a TSurf must not load: kernels, reprojection, other commands, step models,
-#: any plugin but GOCAD's (geobrep's own are declared and imported on first use), meshio.
+#: any plugin but GOCAD's (geobrep's own are declared and imported on first use), meshio, the
+#: models of entity types the file does not hold.
 NOT_FOR_INFO = (
     "scipy",
     "pyproj",
@@ -73,6 +74,8 @@ NOT_FOR_INFO = (
     "geobrep.gis.crs_ops",
     *(module for name, (module, _) in BUILTIN_PLUGINS.items() if name != "gocad"),
     "geobrep.adapters.gocad._model3d",
+    "geobrep.adapters.gocad._model_records",
+    "geobrep.model.arcs",
     "geobrep.adapters.gocad._voxet",
     "geobrep.adapters.gocad._sgrid",
     "geobrep.adapters.gocad._well",
@@ -80,6 +83,13 @@ NOT_FOR_INFO = (
     "geobrep.batch.operations",
     "geobrep.cli.operation",
     *(f"geobrep.cli.{c.module}" for c in COMMANDS if c.module != "info"),
+    *(
+        f"geobrep.model.entities.{module}"
+        for module in (
+            *("annotation", "grid", "nurbs", "octree"),
+            *("polygon", "structured", "tetmesh", "well"),
+        )
+    ),
 )
 
 
