@@ -86,7 +86,7 @@ class _Scratch:
         self.used = np.zeros(n, bool)
         self.local = np.empty(n, np.int64)
 
-    def vertices(self, corners: IntArray) -> IntArray:
+    def vertices(self, corners: NDArray[np.integer[Any]]) -> IntArray:
         """The vertices ``corners`` use, in increasing order."""
         if corners.size == 0:
             return np.zeros(0, np.int64)
