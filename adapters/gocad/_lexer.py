@@ -13,10 +13,9 @@ import contextlib
 import importlib
 import itertools
 from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -44,21 +43,22 @@ BULK_KEYWORDS: tuple[str, ...] = ("VRTX", "PVRTX", "TRGL", "SEG", "TETRA", "ATOM
 KEYWORDS: tuple[str, ...] = (*BULK_KEYWORDS, "BSTONE", "BORDER")
 
 
-@dataclass(frozen=True)
-class Line:
+class Line(NamedTuple):
     """One line that is not part of a bulk run: its 1-based number and text (no newline)."""
 
     number: int
     text: str
 
 
-@dataclass(frozen=True)
-class Run:
-    """Consecutive lines ``first .. first + count - 1`` starting with the same bulk keyword."""
+class Run(NamedTuple):
+    """Consecutive lines ``first .. first + count - 1`` starting with the same bulk keyword.
+
+    (Runs and lines are named tuples: a file makes thousands, and a frozen dataclass costs
+    about three times as much to make.)"""
 
     keyword: str
     first: int
-    count: int
+    count: int  # type: ignore[assignment]  # (a field, not tuple.count)
     start: int  # byte offsets in Source.data
     end: int
 

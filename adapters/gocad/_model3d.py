@@ -128,9 +128,15 @@ class _PatchCorners:
             else np.asarray(surface.patch_labels, dtype=np.int64)
         )
         self.vertices = surface.vertices
-        self.order = np.argsort(labels, kind="stable").astype(np.int64)
-        self.bounds = np.searchsorted(labels[self.order], np.arange(surface.n_patches + 1))
-        self.corners = surface.faces[self.order][:, :3]
+        if labels.shape[0] < 2 or bool((labels[1:] >= labels[:-1]).all()):
+            # the faces are grouped by patch already (the stable sort would keep them)
+            self.order = np.arange(labels.shape[0], dtype=np.int64)
+            self.bounds = np.searchsorted(labels, np.arange(surface.n_patches + 1))
+            self.corners = surface.faces[:, :3]
+        else:
+            self.order = np.argsort(labels, kind="stable").astype(np.int64)
+            self.bounds = np.searchsorted(labels[self.order], np.arange(surface.n_patches + 1))
+            self.corners = surface.faces[self.order][:, :3]
         self.first = np.take(np.ascontiguousarray(surface.vertices.T), self.corners[:, 0], axis=1)
 
     def find(

@@ -95,9 +95,17 @@ def _mesh(vertices: ArrayLike, faces: ArrayLike, entity: str) -> tuple[FloatArra
 
 # --------------------------------------------------------------------------- edge keys
 def _side_ends(faces: IntArray) -> tuple[IntArray, IntArray]:
-    """Start and end vertex of every face side, each (M, k)."""
-    k = faces.shape[1]
-    return faces, faces[:, [*range(1, k), 0]]
+    """Start and end vertex of every face side, each (M, k); the ends are a new array."""
+    return faces, _following(faces)
+
+
+def _following(faces: IntArray) -> IntArray:
+    """``faces[:, [1, ..., k - 1, 0]]`` (a new array) by two slice copies: about three times
+    faster than the fancy indexing."""
+    out = np.empty(faces.shape, dtype=faces.dtype)  # C order, as fancy indexing gives
+    out[:, :-1] = faces[:, 1:]
+    out[:, -1] = faces[:, 0]
+    return out
 
 
 def _key_base(faces: IntArray) -> int:
@@ -411,12 +419,11 @@ def _incidence_by_bits(
     (low vertex, high vertex, side position), keyed in cache-sized slices of faces: the order
     of ``(edge key, position)`` that :func:`_stable_sort` gives, without its copies."""
     m, k = faces.shape
-    following = [*range(1, k), 0]
     packed = np.empty((m, k), dtype=np.int64)
     for start in range(0, m, _KEY_ROWS):
         rows = slice(start, start + _KEY_ROWS)
         first = faces[rows]
-        low = first[:, following]  # a new array: the side ends, then the low ends
+        low = _following(first)  # a new array: the side ends, then the low ends
         high = np.maximum(first, low)
         np.minimum(first, low, out=low)
         low <<= vertex_bits

@@ -552,14 +552,28 @@ def _patch_triangles(
             surface.patch_faces(patch.label)  # raises the surface's own error
         if patch.surface not in grouped:
             vertex_parts.append(np.asarray(surface.vertices, dtype=np.float64))
-            triangles, source = mesh.triangulate(surface.faces)
-            if surface.patch_labels is None:
-                labels = np.zeros(source.shape[0], dtype=np.int64)
+            faces = np.asarray(surface.faces)
+            source: IntArray | None = None  # None: each face is its triangle
+            if faces.ndim == 2 and faces.shape[1] == 3 and faces.dtype == np.int64:
+                # a validated surface's triangles (int64 already: no copy made)
+                triangles = faces.astype(np.int64, copy=False)
             else:
-                labels = np.asarray(surface.patch_labels, dtype=np.int64)[source]
-            order = np.argsort(labels, kind="stable")
-            bounds = np.searchsorted(labels[order], np.arange(surface.n_patches + 1))
-            grouped[patch.surface] = (triangles.astype(np.int64)[order] + total, bounds)
+                triangles, source = mesh.triangulate(faces)
+            if surface.patch_labels is None:
+                labels = np.zeros(triangles.shape[0], dtype=np.int64)
+            else:
+                labels = np.asarray(surface.patch_labels, dtype=np.int64)
+                if source is not None:
+                    labels = labels[source]
+            if labels.shape[0] < 2 or bool((labels[1:] >= labels[:-1]).all()):
+                ordered = labels  # grouped already: the stable sort leaves every face
+                grouped_triangles = triangles + total
+            else:
+                order = np.argsort(labels, kind="stable")
+                ordered = labels[order]
+                grouped_triangles = triangles[order] + total
+            bounds = np.searchsorted(ordered, np.arange(surface.n_patches + 1))
+            grouped[patch.surface] = (grouped_triangles, bounds)
             total += surface.n_vertices
         triangles, bounds = grouped[patch.surface]
         part = triangles[bounds[patch.label] : bounds[patch.label + 1]]
@@ -568,7 +582,7 @@ def _patch_triangles(
     vertices = np.concatenate(vertex_parts) if vertex_parts else np.zeros((0, 3))
     triangles = np.concatenate(triangle_parts) if triangle_parts else np.zeros((0, 3), np.int64)
     owners = np.repeat(np.arange(len(patches), dtype=np.int64), counts)
-    return vertices, triangles.astype(np.int64), owners
+    return vertices, triangles.astype(np.int64, copy=False), owners
 
 
 def _around(
