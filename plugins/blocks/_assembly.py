@@ -13,10 +13,10 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from geobrep import Arc, Block, Corner, Entity, Group, Patch, PatchSide, Scene, Surface, Topology
 from geobrep.geometry.arrays import IntArray
-from geobrep.model.arrays import as_readonly
 from geobrep.plugins import UNIVERSE_KIND
 from geobrep.plugins.blocks._arcs import ArcChains
 from geobrep.plugins.blocks._measures import PatchMeasures
@@ -27,6 +27,12 @@ from geobrep.plugins.blocks._units import block_attributes
 from geobrep.plugins.blocks._universe import Bodies
 
 __all__ = ["Assembly", "assemble"]
+
+
+def _frozen(array: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``array`` (a copy this module made) made read-only, as the models keep their arrays."""
+    array.flags.writeable = False
+    return array
 
 
 @dataclass(frozen=True)
@@ -178,7 +184,7 @@ def _topology(
     # of at least one edge between numbered corners, ids and labels counted from 0): what their
     # validation would do is done here. The topology checks its references.
     corners = tuple(
-        Corner.model_construct(id=k, point=as_readonly(soup.vertices[v]))
+        Corner.model_construct(id=k, point=_frozen(soup.vertices[v]))
         for k, v in enumerate(chains.corners.tolist())
     )
     patch_arcs: list[set[int]] = [set() for _ in range(split.n_patches)]
@@ -196,7 +202,7 @@ def _topology(
         arc_list.append(
             Arc.model_construct(
                 id=a,
-                points=as_readonly(soup.vertices[chain]),
+                points=_frozen(soup.vertices[chain]),
                 start=starts[a],
                 end=ends[a],
                 patches=tuple(members[offsets[a] : offsets[a + 1]]),
