@@ -22,7 +22,7 @@ import binascii
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Final, Literal
+from typing import Any, Final, Literal
 from xml.etree import ElementTree
 
 import numpy as np
@@ -30,7 +30,7 @@ import numpy as np
 from geobrep.adapters.limits import check_declared, inflate_bounded
 from geobrep.errors import FormatError
 
-__all__ = ["check_vtu_sizes", "check_xml_counts"]
+__all__ = ["check_vtu_sizes", "check_xml_counts", "split_base64_blocks"]
 
 _COMPRESSORS: Final[dict[str, Literal["zlib", "lzma"]]] = {
     "vtkZLibDataCompressor": "zlib",
@@ -44,6 +44,19 @@ _HEADER_TYPES: Final[dict[str, np.dtype[np.unsignedinteger]]] = {
 
 def _base64_chars(count: int) -> int:
     return -(-count // 3) * 4
+
+
+def split_base64_blocks(text: str, header: np.dtype[Any]) -> tuple[bytes, bytes]:
+    """A compressed array's base64 text decoded as meshio decodes it: the block table
+    (``[#blocks, block size, last block size, compressed size of each block]``, encoded on its
+    own) and the compressed blocks. The table is shorter than one ``header`` item when the
+    text holds none; bad base64 raises :class:`binascii.Error` (a ValueError)."""
+    item = header.itemsize
+    first = base64.b64decode(text[: _base64_chars(item)])[:item]
+    if len(first) < item:
+        return first, b""
+    chars = _base64_chars((3 + int(np.frombuffer(first, header)[0])) * item)
+    return base64.b64decode(text[:chars]), base64.b64decode(text[chars:])
 
 
 @dataclass
@@ -84,19 +97,14 @@ class _Budget:
 
     def base64_array(self, text: str, name: str) -> None:
         """An array as meshio reads it from base64 text: header first, then the blocks."""
-        item = self.header.itemsize
         try:
-            first = base64.b64decode(text[: _base64_chars(item)])[:item]
-            if len(first) < item:
-                raise FormatError(f"DataArray {name!r} holds no compressed data", self.path)
-            count = int(np.frombuffer(first, self.header)[0])
-            chars = _base64_chars((3 + count) * item)
-            header = base64.b64decode(text[:chars])
-            data = base64.b64decode(text[chars:])
+            header, data = split_base64_blocks(text, self.header)
         except (binascii.Error, ValueError) as exc:
             raise FormatError(
                 f"DataArray {name!r} is not valid base64 ({exc})", self.path
             ) from None
+        if len(header) < self.header.itemsize:
+            raise FormatError(f"DataArray {name!r} holds no compressed data", self.path)
         self.blocks(header, data, name)
 
 

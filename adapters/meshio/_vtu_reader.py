@@ -25,6 +25,8 @@ from xml.etree import ElementTree
 import numpy as np
 from numpy.typing import NDArray
 
+from geobrep.adapters._vtk_xml import split_base64_blocks
+
 __all__ = ["VtuMesh", "read_vtu_mesh"]
 
 _TYPES: Final[dict[str, np.dtype[Any]]] = {
@@ -97,10 +99,6 @@ def read_vtu_mesh(path: Path) -> VtuMesh | None:
         return _Reader(root).mesh()
     except Exception:  # raw appended bytes, or anything meshio reads (or refuses) its own way
         return None
-
-
-def _base64_chars(count: int) -> int:
-    return -(-count // 3) * 4
 
 
 class _Reader:
@@ -234,12 +232,12 @@ class _Reader:
     def compressed(self, text: str, dtype: np.dtype[Any]) -> NDArray[Any]:
         assert self.decompress is not None
         assert self.header is not None
-        item = self.header.itemsize
-        first = base64.b64decode(text[: _base64_chars(item)])[:item]
-        count = int(np.frombuffer(first, self.header)[0])
-        chars = _base64_chars((3 + count) * item)
-        sizes = np.frombuffer(base64.b64decode(text[:chars]), self.header)[3:]
-        data = base64.b64decode(text[chars:])
+        table, data = split_base64_blocks(text, self.header)
+        values = np.frombuffer(table, self.header)
+        count = int(values[0])
+        sizes = values[3:]
+        if len(sizes) != count:
+            raise _NotMineError("a block table shorter than it says")
         offsets = np.empty(sizes.shape[0] + 1, dtype=sizes.dtype)
         offsets[0] = 0
         np.cumsum(sizes, out=offsets[1:])
