@@ -351,3 +351,28 @@ def test_reading_a_vtu_imports_no_meshio(tmp_path: Path) -> None:
     count, loaded = json.loads(done.stdout.splitlines()[-1])
     assert count == len(geobrep.read(path).entities) > 1
     assert loaded == []
+
+
+@pytest.mark.parametrize("text", ["", "AAAA"])
+def test_a_compressed_array_without_its_block_table_is_a_format_error(
+    tmp_path: Path, text: str
+) -> None:
+    rng = np.random.default_rng(5)
+    path = tmp_path / "z.vtu"
+    meshio.write(path, _mesh(rng), binary=True, compression="zlib")
+    xml = path.read_text()
+    start = xml.index(">", xml.index('<DataArray type="Float64" Name="Points"')) + 1
+    path.write_text(xml[:start] + text + xml[xml.index("</DataArray>", start) :])
+    with pytest.raises(FormatError, match="'Points' holds no compressed data"):
+        geobrep.read(path)
+
+
+def test_split_base64_blocks_decodes_the_table_and_the_blocks_apart() -> None:
+    from geobrep.adapters._vtk_xml import split_base64_blocks
+
+    header = np.dtype("<u4")
+    packed = zlib.compress(np.arange(10.0).tobytes())
+    table = np.array([1, 80, 80, len(packed)], header).tobytes()
+    text = (base64.b64encode(table) + base64.b64encode(packed)).decode()
+    assert split_base64_blocks(text, header) == (table, packed)
+    assert split_base64_blocks("", header) == (b"", b"")
