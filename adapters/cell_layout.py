@@ -593,7 +593,7 @@ def _scene_from_header(
     kept = {e.id for e in entities}
     groups = [_group_from_json(g, kept) for g in header.get("groups", [])]
     crs = header.get("crs")
-    return Scene(
+    return Scene.from_validated(  # the entities and groups are validated models already
         entities=entities,
         groups=groups,
         crs=None if crs is None else CRS.model_validate(crs),
@@ -679,7 +679,7 @@ def _scene_from_cells(layout: CellLayout, points: NDArray[np.float64]) -> Scene:
                 ),
             )
         )
-    return Scene(entities=entities)
+    return Scene.from_validated(entities=entities)  # validated models already
 
 
 def _foreign_entity(

@@ -688,6 +688,12 @@ class TestFromValidated:
         )
         assert str(info.value) == str(expected.value)
 
+    @pytest.mark.parametrize("metadata", [[], (), "", 0])
+    def test_metadata_of_another_kind_is_refused_even_when_empty(self, metadata: object) -> None:
+        with pytest.raises(EntityValidationError, match="metadata"):
+            Scene.from_validated(entities=[wells()], metadata=metadata)  # type: ignore[arg-type]
+        assert Scene.from_validated(entities=[wells()], metadata={}).metadata == {}
+
     def test_parts_that_are_no_models_go_through_the_constructor(self) -> None:
         scene = Scene.from_validated(
             entities=[wells()],

@@ -196,8 +196,10 @@ class Scene(FrozenModel):
         )
         if not taken:
             return cls(**values)
-        try:
-            checked = _json_object().validate_python(values["metadata"])
+        try:  # (an empty mapping needs no schema: none is built for it)
+            metadata = values["metadata"]
+            empty = type(metadata) is dict and not metadata
+            checked = {} if empty else _json_object().validate_python(metadata)
         except ValidationError as exc:  # as the constructor reports it
             first = exc.errors()[0]
             loc = ".".join(str(p) for p in ("metadata", *first["loc"]))
