@@ -26,6 +26,9 @@ class Command:
     """the built-in operation the command is derived from"""
     text: str = ""
     """the one-line help of a command that is not an operation's"""
+    dense_linear_algebra: bool = False
+    """whether the command may solve large dense systems (it keeps OpenBLAS's threads; see
+    :mod:`geobrep.cli._blas_threads`)"""
 
     @property
     def help(self) -> str:
@@ -39,7 +42,9 @@ _RUN = "run a pipeline file (read, clip, fit, build blocks, voxelize, write, ...
 COMMANDS: tuple[Command, ...] = (
     Command("info", "info", text="describe a file"),
     Command("plugins", "plugins", text="list plugins and what they register"),
-    Command("demo", "demo", text="run the demo on the built-in sample model"),
+    Command(
+        "demo", "demo", text="run the demo on the built-in sample model", dense_linear_algebra=True
+    ),
     Command("convert", "convert", operation="convert"),
     Command("render", "render", operation="render"),
     Command("view", "view", operation="view"),
@@ -50,8 +55,8 @@ COMMANDS: tuple[Command, ...] = (
     Command("voxelize", "voxelize", operation="voxelize"),
     Command("check", "check", operation="check"),
     Command("repair", "repair", operation="repair"),
-    Command("fit", "fit", operation="fit"),
-    Command("map", "map", operation="map_products"),
-    Command("run", "run", text=_RUN),
+    Command("fit", "fit", operation="fit", dense_linear_algebra=True),
+    Command("map", "map", operation="map_products", dense_linear_algebra=True),
+    Command("run", "run", text=_RUN, dense_linear_algebra=True),
     Command("clean", "clean", text="remove temporaries left by interrupted writes"),
 )

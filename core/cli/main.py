@@ -18,6 +18,7 @@ from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 from geobrep._frame_stack import call_with_room
+from geobrep.cli._blas_threads import one_blas_thread
 from geobrep.cli.commands import COMMANDS, Command
 from geobrep.cli.common import EXIT_EMPTY, CliParser, EmptyResultError, WarningLines, add_verbosity
 from geobrep.errors import GeobrepError
@@ -189,7 +190,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     the caller, no loop of it maps and unmaps a frame chunk per call.
     """
     _freeze_heap_at_exit()
+    if _one_blas_thread_suffices(sys.argv[1:] if argv is None else argv):
+        one_blas_thread()
     return call_with_room(_main, argv)
+
+
+def _one_blas_thread_suffices(argv: Sequence[str]) -> bool:
+    """Whether the command line runs a built-in command that solves no large dense system (or
+    none: help, version, a usage error). A plugin's command keeps OpenBLAS's threads."""
+    words = [word for word in argv if not word.startswith("-")]
+    if not words:
+        return True
+    chosen = next((c for c in COMMANDS if c.name == words[0]), None)
+    return chosen is not None and not chosen.dense_linear_algebra
 
 
 def _main(argv: Sequence[str] | None) -> int:
