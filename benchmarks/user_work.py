@@ -137,6 +137,15 @@ def child(code: str, *args: str) -> Any:
 
 
 # --------------------------------------------------------------------------- 1. start-up
+#: A whole process that imports numpy and pydantic and validates one model: the floor under any
+#: ``geobrep info`` (the scene graph is pydantic models), run in the same environment.
+_FLOOR_PROCESS = """import numpy, pydantic
+class Probe(pydantic.BaseModel):
+    value: int
+Probe(value=1)
+"""
+
+
 def startup(repeat: int, folder: Path) -> None:
     import meshio
     import numpy as np
@@ -168,6 +177,15 @@ def startup(repeat: int, folder: Path) -> None:
         whole_process([str(BIN / "geobrep"), "--help"], repeat),
         "meshio info (same .vtu)",
         meshio_info,
+    )
+    floor = folder / "floor.py"
+    floor.write_text(_FLOOR_PROCESS)
+    row(
+        "floor: python + numpy + pydantic + one model",
+        whole_process([sys.executable, str(floor)], repeat),
+        "meshio info (same .vtu)",
+        meshio_info,
+        "(what any geobrep read pays first)",
     )
     ts = DATA / "2triangles.ts"
     row(
