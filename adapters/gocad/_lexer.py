@@ -453,6 +453,11 @@ def _parse_block(
     the offsets of the blanks ending lines (no separators)."""
     count = starts.shape[0]
     heads = starts[:, None] + np.arange(skip + 1)  # each keyword and the blank after it
+    if count and (
+        int(heads[-1, -1]) >= end - start
+        or (np.frombuffer(data, np.uint8, end - start, start)[heads[:, -1]] != 32).any()
+    ):  # a keyword without a blank after it (a cut file, a bare TRGL): the line parser says so
+        raise BulkParseError
     if integers:
         return _parse_integers(data, start, end, heads, count, trailing)
     # One copy of the run with a byte free at each end for the brackets, translated into a

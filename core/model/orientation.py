@@ -362,7 +362,7 @@ def _standing_orientation(block: Block, volumes: _PatchVolumes) -> BlockOrientat
         total += -share if side == 1 else share  # the positive side lists it flipped
         n += volumes.count[patch]
     eps = float(np.finfo(np.float64).eps)
-    d, r = volumes.diameter, volumes.reach
+    d, r = np.float64(volumes.diameter), np.float64(volumes.reach)  # overflow to inf, not raise
     with np.errstate(over="ignore", invalid="ignore"):
         bound = eps * n * ((64.0 + 11.0 * (n + 1)) * d**3 + 12.0 * r * d * d)
     if not (np.isfinite(total) and np.isfinite(bound) and abs(total) > 2.0 * bound):

@@ -138,6 +138,34 @@ def test_a_mutated_gocad_file_reads_or_fails_with_the_readers_own_format_error(
         assert error.message
 
 
+#: Cases the fuzz test found (hypothesis 6.x's examples change with its version): a run of
+#: TRGL lines cut after a bare keyword (the bulk parser indexed past the text), and a
+#: coordinate near the float64 limit (a block's rounding bound overflowed in Python floats).
+FOUND = [
+    (
+        "surf2d.ts",
+        [
+            ("keyword", 1, b"STATUS:", []),
+            ("duplicate token", 0, 3),
+            ("keyword", 1, b"ASCII_DATA_FILE", [b"-1e308"]),
+            ("truncate", 1329),
+        ],
+    ),
+    ("modelA1.ml", [("garble", 181, 2, b"-1e308")]),
+]
+
+
+@pytest.mark.parametrize(("name", "mutations"), FOUND)
+def test_cases_the_fuzz_found(
+    tmp_path: Path, name: str, mutations: list[tuple[object, ...]]
+) -> None:
+    path = tmp_path / name
+    path.write_bytes(mutate(TEXTS[name], mutations))
+    error = read_or_format_error(path)
+    assert error is not None
+    assert not error.message.startswith(CATCH_ALL), error.message
+
+
 def test_the_mutations_change_the_file() -> None:
     """The strategy's mutations really do something (a fuzz test that mutates nothing passes)."""
     text = TEXTS["2triangles.ts"]
