@@ -8,6 +8,7 @@ the chosen type cannot hold are reported with a :class:`GocadWarning` (never dro
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -65,9 +66,10 @@ def _version(entity: Entity | None) -> str:
 
 
 class _Writer:
-    def __init__(self, scene: Scene, path: Path) -> None:
+    def __init__(self, scene: Scene, path: Path, options: GocadOptions) -> None:
         self.scene = scene
         self.path = path
+        self.options = options
         self.members = MemberFiles(path)
 
     # -- shared head ------------------------------------------------------------------------
@@ -129,7 +131,13 @@ class _Writer:
         surface: Surface,
         extra_header: tuple[tuple[str, str], ...] = (),
         tface_type: str | None = None,
+        in_model: bool = False,
     ) -> bytes:
+        """A TSurf (a Model3d member when ``in_model``); its TFACEs' vertices as the
+        ``tface_vertices`` option says (see :func:`_own_tface_vertices`)."""
+        layout = self.options.tface_vertices or ("own" if in_model else "shared")
+        if layout == "own":
+            surface = _own_tface_vertices(surface)
         out = ObjectText()
         if surface.faces.shape[1] == 4:
             report(f"{surface.label}: quads are written as two triangles each")
@@ -406,7 +414,8 @@ class _Writer:
             # a TSolid's SURFACEs too: the TSolid itself is not written in a Model3d
             member = name_of.get(int(surface.id or 0))
             extra = (("name_in_model_list", member),) if member is not None else ()
-            pieces.append(self.tsurf(surface, extra, tfaces.type_of.get(int(surface.id or 0))))
+            tface_type = tfaces.type_of.get(int(surface.id or 0))
+            pieces.append(self.tsurf(surface, extra, tface_type, in_model=True))
         skipped = [e.label for e in scene.entities if not isinstance(e, Surface | Block)]
         if skipped:
             report(f"a Model3d holds surfaces and regions only; not written: {', '.join(skipped)}")
@@ -731,6 +740,60 @@ def _id_lines(values: list[str]) -> list[str]:
     return ["  " + "  ".join(values[i : i + 5]) for i in range(0, len(values), 5)]
 
 
+def _own_tface_vertices(surface: Surface) -> Surface:
+    """``surface`` with a vertex of its own in each patch (TFACE) that uses it.
+
+    GOCAD writes a Model3d member so, carrying a vertex an earlier TFACE declared into the next
+    as an ``ATOM`` line (an exact duplicate, which the vertex writer turns into ``ATOM``), and
+    the Model3d readers of OpenGeode-GeosciencesIO and RINGMesh need it: they build each TFACE
+    from its own vertex range (OpenGeode-GeosciencesIO crashed on triangles that use an
+    earlier TFACE's vertex). The vertices of each patch keep their order; vertices no triangle
+    uses come last; BSTONEs and BORDERs read from a file follow their vertex into every copy.
+    The surface itself is returned when no vertex is used by two patches.
+    """
+    faces = np.asarray(surface.faces, dtype=np.int64)
+    n = surface.n_vertices
+    if surface.patch_labels is None or faces.shape[0] == 0 or n == 0:
+        return surface
+    labels = np.asarray(surface.patch_labels, dtype=np.int64)
+    keys = (labels[:, None] * n + faces).ravel()
+    unique_keys, new_faces = np.unique(keys, return_inverse=True)
+    copied = unique_keys % n
+    if copied.shape[0] == np.unique(copied).shape[0]:
+        return surface  # each vertex is in one patch already
+    used = np.zeros(n, dtype=np.bool_)
+    used[copied] = True
+    source = np.concatenate([copied, np.flatnonzero(~used)])
+    changes: dict[str, Any] = {
+        "vertices": np.asarray(surface.vertices)[source],
+        "faces": new_faces.reshape(faces.shape),
+        "point_data": surface.point_data.take(source),
+    }
+    meta = gocad_metadata(surface)
+    if meta.get("bstones") or meta.get("borders"):
+        order = np.argsort(source, kind="stable")
+        ranked = source[order]
+        part_of = np.concatenate([unique_keys // n, np.full(source.shape[0] - copied.shape[0], -1)])
+
+        def copies(vertex: int) -> list[int]:
+            low, high = np.searchsorted(ranked, [vertex, vertex + 1])
+            found: list[int] = order[low:high].tolist()
+            return found
+
+        bstones = [c for v in meta.get("bstones", []) if 0 <= int(v) < n for c in copies(int(v))]
+        borders = [
+            [a2, b2]
+            for a, b in meta.get("borders", [])
+            if 0 <= int(a) < n and 0 <= int(b) < n
+            for a2 in copies(int(a))
+            for b2 in copies(int(b))
+            if part_of[a2] == part_of[b2]
+        ]
+        gocad = {**meta, "bstones": bstones, "borders": borders}
+        changes["metadata"] = {**surface.metadata, "gocad": gocad}
+    return surface.replace(**changes)
+
+
 def _triangles(surface: Surface) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     faces = np.asarray(surface.faces, dtype=np.int64)
     if faces.shape[1] == 3:
@@ -748,7 +811,7 @@ def write_gocad(scene: Scene, path: Path, options: GocadOptions | None = None) -
         raise FormatError(
             "cannot tell the GOCAD object type from the extension: use object_type=", target
         )
-    writer = _Writer(scene, target)
+    writer = _Writer(scene, target, options)
     pieces: list[bytes] = []
     if object_type == "Model3d":
         pieces.append(writer.model3d())

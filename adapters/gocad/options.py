@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import BaseModel, ConfigDict, Field
 
 __all__ = ["GocadOptions"]
@@ -30,6 +32,13 @@ class GocadOptions(BaseModel):
     ``HeterogeneousGroup``, ``Voxet``, ``SGrid`` or ``Well``; default: from the extension
     (.ts .pl .vs .so .ml .gp .vo .sg .wl)."""
 
+    tface_vertices: Literal["own", "shared"] | None = None
+    """Writing a surface of several patches (TFACEs): ``"own"``, each TFACE declares every
+    vertex its triangles use, a vertex an earlier TFACE declared coming again as an ``ATOM``
+    (as GOCAD writes them; OpenGeode-GeosciencesIO needs it), so a border vertex is read back
+    once per patch; ``"shared"``, each vertex once, later TFACEs' triangles using earlier ids
+    (the surface reads back vertex for vertex). Default: ``"own"`` in a Model3d, ``"shared"``
+    in a TSurf file."""
     voxet_ascii: bool = False
     """Writing a Voxet: its properties in one ``ASCII_DATA_FILE`` table of ``I J K value...``
     rows (as test.vo; the form OpenGeode-GeosciencesIO reads) instead of raw big-endian

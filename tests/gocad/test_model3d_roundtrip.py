@@ -74,7 +74,9 @@ def _summary(scene: Scene, topology: Topology | None = None) -> dict[str, Any]:
     )
     return {
         "surfaces": sorted(
-            (s.name, s.kind, s.n_vertices > 0, _point(s.vertices.mean(axis=0)))
+            # the centroid of the triangles' corners: the same whether patches share their
+            # border vertices or each patch has its own (a Model3d member's TFACEs)
+            (s.name, s.kind, s.n_vertices > 0, _point(s.vertices[s.faces].reshape(-1, 3).mean(0)))
             for s in scene.surfaces
             if s.n_faces
         ),
