@@ -165,6 +165,10 @@ def _losses(scene: Scene, path: Path) -> list[str]:
             continue
         dropped[entity.type] = dropped.get(entity.type, 0) + 1
     kinds = ", ".join(sorted(held))
+    if object_type == "Model3d":
+        from geobrep.adapters.gocad._writer import model3d_copies
+
+        grid_lost = grid_lost + model3d_copies(scene)
     return grid_lost + [
         f"{count} {type_name} entities dropped (a GOCAD {object_type} file holds {kinds})"
         for type_name, count in sorted(dropped.items())

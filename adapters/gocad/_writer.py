@@ -740,6 +740,40 @@ def _id_lines(values: list[str]) -> list[str]:
     return ["  " + "  ".join(values[i : i + 5]) for i in range(0, len(values), 5)]
 
 
+def _patch_vertices(surface: Surface) -> tuple[NDArray[np.int64], NDArray[np.int64]] | None:
+    """The sorted ``patch label * n_vertices + vertex`` keys of the vertices each patch uses
+    and each face corner's index among them; None when no vertex is used by two patches."""
+    faces = np.asarray(surface.faces, dtype=np.int64)
+    n = surface.n_vertices
+    if surface.patch_labels is None or faces.shape[0] == 0 or n == 0:
+        return None
+    labels = np.asarray(surface.patch_labels, dtype=np.int64)
+    keys = (labels[:, None] * n + faces).ravel()
+    unique_keys, corners = np.unique(keys, return_inverse=True)
+    if unique_keys.shape[0] == np.unique(unique_keys % n).shape[0]:
+        return None
+    return unique_keys, corners.reshape(faces.shape)
+
+
+def tface_copies_sentence(surface: Surface, n_points: int | None = None) -> str:
+    """What writing ``surface`` with a vertex of its own in each TFACE does to it (the
+    format's losses and the writer's warning say it alike)."""
+    if n_points is None:
+        split = _patch_vertices(surface)
+        used = np.unique(np.asarray(surface.faces)).shape[0]
+        n_points = surface.n_vertices + (0 if split is None else split[0].shape[0] - used)
+    return (
+        f"{surface.label}: {n_points - surface.n_vertices} copies of vertices its patches share "
+        "are written, one in each TFACE that uses them (ATOM lines, as GOCAD writes a Model3d; "
+        f"tface_vertices='shared' writes each once): {n_points} points read back"
+    )
+
+
+def model3d_copies(scene: Scene) -> list[str]:
+    """:func:`tface_copies_sentence` of each surface a Model3d write gives copies to."""
+    return [tface_copies_sentence(s) for s in scene.surfaces if _patch_vertices(s) is not None]
+
+
 def _own_tface_vertices(surface: Surface) -> Surface:
     """``surface`` with a vertex of its own in each patch (TFACE) that uses it.
 
@@ -751,19 +785,17 @@ def _own_tface_vertices(surface: Surface) -> Surface:
     uses come last; BSTONEs and BORDERs read from a file follow their vertex into every copy.
     The surface itself is returned when no vertex is used by two patches.
     """
-    faces = np.asarray(surface.faces, dtype=np.int64)
-    n = surface.n_vertices
-    if surface.patch_labels is None or faces.shape[0] == 0 or n == 0:
-        return surface
-    labels = np.asarray(surface.patch_labels, dtype=np.int64)
-    keys = (labels[:, None] * n + faces).ravel()
-    unique_keys, new_faces = np.unique(keys, return_inverse=True)
-    copied = unique_keys % n
-    if copied.shape[0] == np.unique(copied).shape[0]:
+    split = _patch_vertices(surface)
+    if split is None:
         return surface  # each vertex is in one patch already
+    unique_keys, new_faces = split
+    n = surface.n_vertices
+    faces = np.asarray(surface.faces)
+    copied = unique_keys % n
     used = np.zeros(n, dtype=np.bool_)
     used[copied] = True
     source = np.concatenate([copied, np.flatnonzero(~used)])
+    report(tface_copies_sentence(surface, source.shape[0]))
     changes: dict[str, Any] = {
         "vertices": np.asarray(surface.vertices)[source],
         "faces": new_faces.reshape(faces.shape),

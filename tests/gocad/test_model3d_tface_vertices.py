@@ -123,3 +123,15 @@ def test_opengeode_reads_the_written_cake(cake: geobrep.Scene, tmp_path: Path) -
     counts = tuple(int(v) for v in done.stdout.split())
     expected = (len(cake.topology.corners), len(cake.topology.arcs), len(cake.patches))
     assert counts == (*expected, len(cake.blocks))
+
+
+def test_convert_reports_the_copies_and_verifies(tmp_path: Path) -> None:
+    source = DATA / "cube_model_equi.so"
+    report = geobrep.convert(source, tmp_path / "cube.ml", verify=True).reports[0]
+    assert report.status == "converted", report.error
+    said = [line for line in report.lost if "copies of vertices its patches share" in line]
+    assert said
+    again = read_quietly(tmp_path / "cube.ml")
+    for line in said:
+        name, count = re.match(r"Surface '(.+)': .* (\d+) points read back$", line).groups()  # type: ignore[union-attr]
+        assert again[name].n_points == int(count)
