@@ -12,6 +12,7 @@ import bisect
 import contextlib
 import importlib
 import itertools
+import struct
 from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
@@ -483,11 +484,14 @@ def _parse_block(
     if step < 2 or step * count != len(flat) or flat[::step].count(marker) != count:
         raise BulkParseError
     del flat[::step]
-    try:  # only numbers are left (the markers counted above): faster than np.fromiter
-        array = np.array(flat, dtype=np.float64)
-    except (ValueError, TypeError, OverflowError) as exc:
+    # Only numbers are left (the markers counted above). struct converts each as float()
+    # does (ints too), straight into the array: twice as fast as np.array(flat).
+    array = np.empty((count, step - 1), dtype=np.float64)
+    try:
+        struct.pack_into(f"{len(flat)}d", array, 0, *flat)
+    except (struct.error, OverflowError) as exc:
         raise BulkParseError from exc
-    return array.reshape(count, step - 1)
+    return array
 
 
 def _parse_integers(
@@ -524,7 +528,7 @@ def _parse_integers(
     if step >= 2 and step * count == array.shape[0]:
         grid = array.reshape(count, step)
         if (grid[:, 0] == marker).all() and np.count_nonzero(array == marker) == count:
-            if np.abs(grid[:, 1:]).max() >= _INT_LIMIT:
+            if np.abs(array).max() >= _INT_LIMIT:  # (the markers are small)
                 raise BulkParseError  # numpy saturated: let the exact path decide
             result: NDArray[np.int64] = np.ascontiguousarray(grid[:, 1:])
             return result
