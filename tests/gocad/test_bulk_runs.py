@@ -139,3 +139,18 @@ def test_a_bad_id_in_a_batched_run_is_reported_on_its_line(tmp_path: Path) -> No
     path.write_text(TWO_SURFACES.replace("TRGL 3 2 1", "TRGL 3 2 1.5"))
     with pytest.raises(FormatError, match=r"bad2\.ts:27"):
         _scene(path)
+
+
+@pytest.mark.parametrize("blank", [" ", "\t ", "  "])
+def test_a_run_ending_with_a_keyword_and_blanks_is_reported_on_its_line(
+    tmp_path: Path, blank: str
+) -> None:
+    """An ATOM line without ids at the end of its run: the bulk parse gives way to the line
+    parser, which names the line (it used to fail with an IndexError)."""
+    head = ["GOCAD TSurf 1", "HEADER {", "name:a", "}", "TFACE"]
+    body = ["VRTX 1 0 0 0", "VRTX 2 1 0 0", "VRTX 3 0 1 0", "ATOM 4 1", "ATOM" + blank]
+    text = "\n".join([*head, *body, "TRGL 1 2 3", "END", ""])
+    path = tmp_path / "blank.ts"
+    path.write_text(text)
+    with pytest.raises(FormatError, match=r"blank\.ts:10: ATOM needs a new id"):
+        _scene(path)
