@@ -268,36 +268,82 @@ def _cross_rows(u: FloatArray, v: FloatArray) -> FloatArray:
     return np.stack([uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx], axis=-2)
 
 
-def _apart(one: FloatArray, other: FloatArray, tol: float) -> BoolArray:
-    """Whether triangles ``one`` (component-major: (corner, xyz, K)), grown by ``tol`` to the
-    region the edge test calls inside, lie wholly more than ``tol`` beyond a plane of ``other``:
-    above or under its plane (Möller's plane-side test), or outside one of its sides (the plane
-    through the side perpendicular to the triangle)."""
+@dataclass(frozen=True)
+class _Planes:
+    """Per triangle (component-major, last axis the triangle): the triangle grown by a margin
+    about its incentre, its unit normal and plane level, and the in-plane inward normals of its
+    sides (over their lengths) with their levels — what :func:`_beyond` reads of each pair."""
+
+    grown: FloatArray  # (corner, xyz, T)
+    unit: FloatArray  # (xyz, T)
+    level: FloatArray  # (T,): unit . corner 0
+    inward: FloatArray  # (side, xyz, T): side j runs from corner j to j + 1
+    offset: FloatArray  # (side, T): inward . a corner of the side
+
+
+def _planes(corners: FloatArray, margin: float) -> _Planes:
+    """:class:`_Planes` of triangles (component-major: (corner, xyz, T)), grown by ``margin``
+    to the region the edge test calls inside: scaled about the incentre by (r + margin) / r,
+    r the inradius."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        # The grown triangle: scaled about the incentre by (r + tol) / r, r the inradius.
-        side = one[_NEXT] - one  # side j runs from corner j to j + 1
-        length = np.sqrt((side * side).sum(axis=1))  # (side, K)
+        side = corners[_NEXT] - corners  # side j runs from corner j to j + 1
+        length = np.sqrt((side * side).sum(axis=1))  # (side, T)
         perimeter = length.sum(axis=0)
         normal = _cross_rows(side[0], -side[2])
         area2 = np.sqrt((normal * normal).sum(axis=0))
-        centre = (length[[1, 2, 0], None, :] * one).sum(axis=0) / perimeter
-        grown = centre + (1.0 + tol * perimeter / area2) * (one - centre)
-        # The planes of the other triangle.
-        side = other[_NEXT] - other
-        normal = _cross_rows(side[0], -side[2])
-        unit = normal / np.sqrt((normal * normal).sum(axis=0))
-        inward = _cross_rows(unit, side) / np.sqrt((side * side).sum(axis=1))[:, None, :]
-        height = (grown * unit).sum(axis=1) - (other[0] * unit).sum(axis=0)  # (corner, K)
-        reach = (grown[:, None] * inward).sum(axis=2) - (other * inward).sum(axis=1)
-    above, under, outside = height > tol, height < -tol, reach < -tol  # outside: (corner, side, K)
+        centre = (length[[1, 2, 0], None, :] * corners).sum(axis=0) / perimeter
+        grown = centre + (1.0 + margin * perimeter / area2) * (corners - centre)
+        unit = normal / area2
+        inward = _cross_rows(unit, side) / length[:, None, :]
+    level = (corners[0] * unit).sum(axis=0)
+    offset = (corners * inward).sum(axis=1)
+    return _Planes(grown, unit, level, inward, offset)
+
+
+def _above_or_under(planes: _Planes, one: IntArray, other: IntArray, margin: float) -> BoolArray:
+    """Whether triangles ``one``, grown, lie wholly more than ``margin`` above or under the
+    plane of triangles ``other`` (Möller's plane-side test; rows of ``planes``)."""
+    grown = np.take(planes.grown, one, axis=2)
+    unit = np.take(planes.unit, other, axis=1)
+    with np.errstate(invalid="ignore"):
+        height = (grown * unit).sum(axis=1) - np.take(planes.level, other)  # (corner, K)
+    above, under = height > margin, height < -margin
+    return np.asarray((above[0] & above[1] & above[2]) | (under[0] & under[1] & under[2]))
+
+
+def _outside_a_side(planes: _Planes, one: IntArray, other: IntArray, margin: float) -> BoolArray:
+    """Whether triangles ``one``, grown, lie wholly more than ``margin`` outside one side of
+    triangles ``other`` (the plane through the side perpendicular to the triangle)."""
+    grown = np.take(planes.grown, one, axis=2)
+    inward = np.take(planes.inward, other, axis=2)
+    with np.errstate(invalid="ignore"):
+        reach = (grown[:, None] * inward).sum(axis=2) - np.take(planes.offset, other, axis=1)
+    outside = reach < -margin  # (corner, side, K)
     beyond = outside[0] & outside[1] & outside[2]  # (side, K)
-    return np.asarray(
-        (above[0] & above[1] & above[2])
-        | (under[0] & under[1] & under[2])
-        | beyond[0]
-        | beyond[1]
-        | beyond[2]
-    )
+    return np.asarray(beyond[0] | beyond[1] | beyond[2])
+
+
+def _separated_rows(planes: _Planes, one: IntArray, other: IntArray, margin: float) -> BoolArray:
+    """Pairs (rows ``one[k]``, ``other[k]`` of ``planes``) a plane of either keeps more than
+    ``margin`` from the other grown: the plane-side tests both ways first (cheap), the side
+    planes only for the pairs they leave."""
+    apart = np.zeros(one.shape[0], dtype=np.bool_)
+    rest = np.arange(one.shape[0])
+    tests = (_above_or_under, _outside_a_side)
+    for test in tests:
+        for a, b in ((one, other), (other, one)):
+            if rest.size == 0:
+                return apart
+            hit = test(planes, a[rest], b[rest], margin)
+            apart[rest[hit]] = True
+            rest = rest[~hit]
+    return apart
+
+
+def _separation_margin(corners: FloatArray, tol: float) -> float:
+    """A little more than ``tol``, against rounding in the planes and the grown corners."""
+    scale = float(np.abs(corners).max(initial=0.0))
+    return tol * (1.0 + 1e-6) + 1e-12 * scale
 
 
 def separated(first: FloatArray, second: FloatArray, tol: float) -> BoolArray:
@@ -314,14 +360,11 @@ def separated(first: FloatArray, second: FloatArray, tol: float) -> BoolArray:
     >>> separated(flat, flat + [0.0, 0.0, 1.0], 0.1).tolist(), separated(flat, flat, 0.1).tolist()
     ([True], [False])
     """
-    # A little more than tol, against rounding in the planes and the grown corners.
-    scale = max(float(np.abs(first).max(initial=0.0)), float(np.abs(second).max(initial=0.0)))
-    margin = tol * (1.0 + 1e-6) + 1e-12 * scale
-    one, other = first.transpose(1, 2, 0).copy(), second.transpose(1, 2, 0).copy()
-    apart = _apart(one, other, margin)
-    rest = np.flatnonzero(~apart)
-    apart[rest] = _apart(other[:, :, rest], one[:, :, rest], margin)
-    return apart
+    k = first.shape[0]
+    both = np.concatenate([first, second]).transpose(1, 2, 0).copy()
+    margin = _separation_margin(both, tol)
+    rows = np.arange(k)
+    return _separated_rows(_planes(both, margin), rows, rows + k, margin)
 
 
 def triangles_intersect(first: FloatArray, second: FloatArray, tol: float) -> BoolArray:
@@ -343,6 +386,32 @@ def triangles_intersect(first: FloatArray, second: FloatArray, tol: float) -> Bo
         one, other = first[start : start + _BATCH], second[start : start + _BATCH]
         todo = np.flatnonzero(~separated(one, other, tol))
         one, other = one[todo], other[todo]
+        hits[start + todo] = _edges_touching(one, other, tol) | _edges_touching(other, one, tol)
+    return hits
+
+
+def _pairs_intersect(corners: FloatArray, i: IntArray, j: IntArray, tol: float) -> BoolArray:
+    """:func:`triangles_intersect` of triangle pairs ``(i[k], j[k])`` of ``corners`` (the soup's,
+    component-major: (corner, xyz, T)): each triangle's planes are computed once, however many
+    pairs it is in. The separation margin follows the largest coordinate of all the pairs
+    (never less than a batch's: the pairs it keeps apart are kept apart there too)."""
+    hits = np.zeros(i.shape[0], dtype=np.bool_)
+    if i.size == 0:
+        return hits
+    used = np.zeros(corners.shape[2], dtype=np.bool_)
+    used[i] = True
+    used[j] = True
+    rows = np.flatnonzero(used)
+    slot = np.empty(corners.shape[2], dtype=np.int64)
+    slot[rows] = np.arange(rows.shape[0])
+    mine = np.take(corners, rows, axis=2)
+    margin = _separation_margin(mine, tol)
+    planes = _planes(mine, margin)
+    by_row = np.ascontiguousarray(mine.transpose(2, 0, 1))  # (T, corner, xyz)
+    for start in range(0, i.shape[0], _BATCH):
+        a, b = slot[i[start : start + _BATCH]], slot[j[start : start + _BATCH]]
+        todo = np.flatnonzero(~_separated_rows(planes, a, b, margin))
+        one, other = np.take(by_row, a[todo], axis=0), np.take(by_row, b[todo], axis=0)
         hits[start + todo] = _edges_touching(one, other, tol) | _edges_touching(other, one, tol)
     return hits
 
@@ -435,11 +504,11 @@ def _crossings(
     if pairs is not None:
         near = _boxes_within(local, ti, tj, tol)
         i, j, ti, tj = i[near], j[near], ti[near], tj[near]
-    first, second = np.take(local, ti, axis=0), np.take(local, tj, axis=0)
-    hit = triangles_intersect(first, second, tol)
-    i, j, first, second = i[hit], j[hit], first[hit], second[hit]
+    hit = _pairs_intersect(soup.corners, i, j, tol)
+    i, j, ti, tj = i[hit], j[hit], ti[hit], tj[hit]
     if i.size == 0:
         return []
+    first, second = np.take(local, ti, axis=0), np.take(local, tj, axis=0)
     real = ~_along_shared_lines(soup, first, second, i, j, tol)
     i, j, first, second = i[real], j[real], first[real], second[real]
     if i.size == 0:
