@@ -22,7 +22,7 @@ from geobrep.geometry.graph import (
     hashed_order,
 )
 from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
-from geobrep.geometry.sorting import radix_order, radix_pays
+from geobrep.geometry.sorting import RADIX_MIN, digit_order, radix_order, radix_pays, sorted_keys
 
 __all__ = [
     "boundary_edges",
@@ -426,19 +426,31 @@ def _incidence_by_radix(
     low = _following(faces)
     high = np.maximum(faces, low)
     np.minimum(faces, low, out=low)
-    low <<= vertex_bits
-    low |= high
-    keys = low.reshape(-1)
-    position = radix_order(keys, 2 * vertex_bits)
-    ordered = np.take(keys, position)
-    starts_mask = np.ones(ordered.shape[0], dtype=np.bool_)
-    np.not_equal(ordered[1:], ordered[:-1], out=starts_mask[1:])
-    starts = np.flatnonzero(starts_mask)
-    unique_keys = np.take(ordered, starts)
-    edges = np.empty((starts.shape[0], 2), dtype=np.int64)
-    np.right_shift(unique_keys, vertex_bits, out=edges[:, 0])
-    np.bitwise_and(unique_keys, (1 << vertex_bits) - 1, out=edges[:, 1])
-    offsets = np.append(starts, ordered.shape[0]).astype(np.int64, copy=False)
+    if vertex_bits <= 16:  # the vertices are the two digits
+        low16, high16 = low.astype(np.uint16).reshape(-1), high.astype(np.uint16).reshape(-1)
+        position = digit_order(low16, high16)
+        low16, high16 = np.take(low16, position), np.take(high16, position)
+        starts_mask = np.ones(position.shape[0], dtype=np.bool_)
+        np.not_equal(low16[1:], low16[:-1], out=starts_mask[1:])
+        starts_mask[1:] |= high16[1:] != high16[:-1]
+        starts = np.flatnonzero(starts_mask)
+        edges = np.empty((starts.shape[0], 2), dtype=np.int64)
+        edges[:, 0] = np.take(low16, starts)
+        edges[:, 1] = np.take(high16, starts)
+    else:
+        low <<= vertex_bits
+        low |= high
+        keys = low.reshape(-1)
+        position = radix_order(keys, 2 * vertex_bits)
+        ordered = np.take(keys, position)
+        starts_mask = np.ones(ordered.shape[0], dtype=np.bool_)
+        np.not_equal(ordered[1:], ordered[:-1], out=starts_mask[1:])
+        starts = np.flatnonzero(starts_mask)
+        unique_keys = np.take(ordered, starts)
+        edges = np.empty((starts.shape[0], 2), dtype=np.int64)
+        np.right_shift(unique_keys, vertex_bits, out=edges[:, 0])
+        np.bitwise_and(unique_keys, (1 << vertex_bits) - 1, out=edges[:, 1])
+    offsets = np.append(starts, position.shape[0]).astype(np.int64, copy=False)
     face = position // k
     return edges, offsets, face, position - face * k
 
@@ -505,7 +517,14 @@ def is_consistently_oriented(faces: ArrayLike) -> bool:
     False
     """
     f = _as_faces(faces, "is_consistently_oriented")
-    s = np.sort(_directed_keys(f))
+    if f.size >= RADIX_MIN and int(f.max()) < 1 << 16 and int(f.min()) >= 0:
+        # sides ordered by (start, end) in two radix passes of their 16-bit vertices
+        start = f.astype(np.uint16).reshape(-1)
+        end = _following(f).astype(np.uint16).reshape(-1)
+        order = digit_order(start, end)
+        start, end = np.take(start, order), np.take(end, order)
+        return bool(((start[1:] != start[:-1]) | (end[1:] != end[:-1])).all())
+    s = sorted_keys(_directed_keys(f))
     return bool((s[1:] != s[:-1]).all())
 
 

@@ -10,15 +10,16 @@ order (the order :func:`numpy.argsort` with ``kind="stable"`` gives).
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from geobrep.geometry.arrays import IntArray
 
-__all__ = ["RADIX_PASSES", "radix_order", "sorted_keys"]
+__all__ = ["RADIX_MIN", "RADIX_PASSES", "digit_order", "radix_order", "radix_pays", "sorted_keys"]
 
 #: Keys of up to this many 16-bit digits are sorted by radix passes; wider keys, or fewer
-#: than ``_RADIX_MIN`` of them, by ``np.sort`` (faster then).
+#: than ``RADIX_MIN`` of them, by ``np.sort`` (faster then).
 RADIX_PASSES = 3
-_RADIX_MIN = 4096
+RADIX_MIN = 4096
 _DIGIT = 16
 _MASK = (1 << _DIGIT) - 1
 
@@ -39,9 +40,22 @@ def radix_order(keys: IntArray, bits: int) -> IntArray:
     return order.astype(np.int64, copy=False)
 
 
+def digit_order(*digits: NDArray[np.uint16]) -> IntArray:
+    """The stable lexicographic order of rows given as 16-bit columns, the most significant
+    first (``np.lexsort(digits[::-1])``): one radix pass per column.
+
+    >>> digit_order(np.array([1, 0, 1], np.uint16), np.array([5, 9, 2], np.uint16)).tolist()
+    [1, 2, 0]
+    """
+    order = np.argsort(digits[-1], kind="stable")
+    for digit in digits[-2::-1]:
+        order = np.take(order, np.argsort(np.take(digit, order), kind="stable"))
+    return order.astype(np.int64, copy=False)
+
+
 def radix_pays(n: int, bits: int) -> bool:
     """Whether :func:`radix_order` beats a comparison sort of ``n`` keys of ``bits`` bits."""
-    return n >= _RADIX_MIN and -(-max(bits, 1) // _DIGIT) <= RADIX_PASSES
+    return n >= RADIX_MIN and -(-max(bits, 1) // _DIGIT) <= RADIX_PASSES
 
 
 def sorted_keys(keys: IntArray) -> IntArray:
@@ -51,7 +65,7 @@ def sorted_keys(keys: IntArray) -> IntArray:
     [-1, 3, 5]
     """
     flat = keys.reshape(-1)
-    if flat.shape[0] < _RADIX_MIN:
+    if flat.shape[0] < RADIX_MIN:
         return np.sort(flat)
     low = int(flat.min())
     bits = (int(flat.max()) - low).bit_length()
