@@ -13,7 +13,6 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -208,19 +207,21 @@ def _box_diagonal(points: NDArray[np.float64]) -> float:
     return diagonal if np.isfinite(diagonal) else float(np.finfo(np.float64).max)
 
 
-@dataclass
 class _TFaceMatcher:
     """Header TFACEs matched to the TFACE parts of the member TSurfs, one patch each."""
 
-    surfaces: list[Surface]
-    z_sign: float
-    key_tolerance: float
-    builder: Diagnostics
-    patches: list[Patch] = field(default_factory=list)
-    flipped: dict[int, bool] = field(default_factory=dict)  # TFACE id -> key triangle reversed
-    key_faces: dict[int, dict[int, int | None]] = field(default_factory=dict)
-    """surface id -> patch label -> face index of its key triangle (None: not found)."""
-    _corners: dict[int, _PatchCorners] = field(default_factory=dict)
+    def __init__(
+        self, surfaces: list[Surface], z_sign: float, key_tolerance: float, builder: Diagnostics
+    ) -> None:
+        self.surfaces = surfaces
+        self.z_sign = z_sign
+        self.key_tolerance = key_tolerance
+        self.builder = builder
+        self.patches: list[Patch] = []
+        self.flipped: dict[int, bool] = {}  # TFACE id -> key triangle reversed
+        self.key_faces: dict[int, dict[int, int | None]] = {}
+        """surface id -> patch label -> face index of its key triangle (None: not found)."""
+        self._corners: dict[int, _PatchCorners] = {}
 
     def match_all(self, header: Model3dHeader) -> None:
         by_name: dict[str, Surface] = {}

@@ -2,13 +2,14 @@
 fills while it reads their lines (:meth:`ModelDraft.freeze`, :meth:`SolidDraft.freeze` give the
 records).
 
-Imported when a file has a Model3d, TSolid or LightTSolid object: the dataclasses are made at
-import (about 0.4 ms each), which a TSurf, PLine or VSet read does not need.
+Imported when a file has a Model3d, TSolid or LightTSolid object. The records are named
+tuples and the drafts plain classes with slots: a frozen dataclass costs about half a
+millisecond to make at import (its generated methods are compiled), which every first read of
+such a file would pay.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import NamedTuple
 
 __all__ = [
@@ -31,8 +32,7 @@ __all__ = [
 
 
 # -- Model3d header ---------------------------------------------------------------------------
-@dataclass(frozen=True)
-class TFaceEntry:
+class TFaceEntry(NamedTuple):
     """``TFACE <id> <geological type> <TSurf name>`` of a Model3d header and its key triangle
     (three coordinate lines, as written: z not yet turned by ZPOSITIVE)."""
 
@@ -43,8 +43,7 @@ class TFaceEntry:
     line: int
 
 
-@dataclass(frozen=True)
-class RegionEntry:
+class RegionEntry(NamedTuple):
     """``REGION <id> <name>`` and the signed TFACE ids that follow it."""
 
     id: int
@@ -53,8 +52,7 @@ class RegionEntry:
     line: int
 
 
-@dataclass(frozen=True)
-class ModelList:
+class ModelList(NamedTuple):
     """``LAYER`` / ``FAULT_BLOCK`` (REGION ids) or ``SURFACE`` / ``FAULT`` / ``BOUNDARY`` /
     ``UNIT`` (TFACE ids) of a Model3d header."""
 
@@ -64,8 +62,7 @@ class ModelList:
     line: int
 
 
-@dataclass(frozen=True)
-class Model3dHeader:
+class Model3dHeader(NamedTuple):
     """What a Model3d object's header declares, in file order."""
 
     tsurfs: tuple[str, ...] = ()
@@ -85,8 +82,7 @@ class SolidTriangle(NamedTuple):
 KeyVertices = SolidTriangle
 
 
-@dataclass(frozen=True)
-class SolidTFace:
+class SolidTFace(NamedTuple):
     """``TFACE <id>`` of a TSolid MODEL surface: its key triangle and triangles."""
 
     id: int
@@ -94,24 +90,21 @@ class SolidTFace:
     triangles: tuple[SolidTriangle, ...]
 
 
-@dataclass(frozen=True)
-class SolidSurface:
+class SolidSurface(NamedTuple):
     """``SURFACE <name>`` of a TSolid MODEL section."""
 
     name: str
     tfaces: tuple[SolidTFace, ...]
 
 
-@dataclass(frozen=True)
-class ModelRegion:
+class ModelRegion(NamedTuple):
     """``MODEL_REGION <name> <±tface>``: the region on that side of the TFACE's key triangle."""
 
     name: str
     signed_tface: int
 
 
-@dataclass(frozen=True)
-class SolidModel:
+class SolidModel(NamedTuple):
     """The ``MODEL`` section of a TSolid / LightTSolid."""
 
     surfaces: tuple[SolidSurface, ...] = ()
@@ -119,34 +112,44 @@ class SolidModel:
 
 
 # -- drafts -----------------------------------------------------------------------------------
-@dataclass
 class TFaceDraft:
-    id: int
-    type: str
-    tsurf: str
-    line: int
-    key: list[tuple[float, float, float]] = field(default_factory=list)
+    """A header ``TFACE`` line and the key-triangle lines read after it."""
+
+    __slots__ = ("id", "key", "line", "tsurf", "type")
+
+    def __init__(self, id: int, type: str, tsurf: str, line: int) -> None:
+        self.id = id
+        self.type = type
+        self.tsurf = tsurf
+        self.line = line
+        self.key: list[tuple[float, float, float]] = []
 
 
-@dataclass
 class ListDraft:
-    keyword: str
-    name: str
-    line: int
-    region_id: int | None = None  # REGION only
-    items: list[int] = field(default_factory=list)
-    closed: bool = False  # the list's 0 was read
+    """A ``REGION`` / ``LAYER`` / ... line and the ids read after it."""
+
+    __slots__ = ("closed", "items", "keyword", "line", "name", "region_id")
+
+    def __init__(self, keyword: str, name: str, line: int, region_id: int | None = None) -> None:
+        self.keyword = keyword
+        self.name = name
+        self.line = line
+        self.region_id = region_id  # REGION only
+        self.items: list[int] = []
+        self.closed = False  # the list's 0 was read
 
 
-@dataclass
 class ModelDraft:
     """A Model3d header while its lines are read; :meth:`freeze` gives the record."""
 
-    tsurfs: list[str] = field(default_factory=list)
-    tfaces: list[TFaceDraft] = field(default_factory=list)
-    lists: list[ListDraft] = field(default_factory=list)
-    key_for: TFaceDraft | None = None  # the TFACE whose key-triangle lines may follow
-    current: ListDraft | None = None  # the list whose ids may follow
+    __slots__ = ("current", "key_for", "lists", "tfaces", "tsurfs")
+
+    def __init__(self) -> None:
+        self.tsurfs: list[str] = []
+        self.tfaces: list[TFaceDraft] = []
+        self.lists: list[ListDraft] = []
+        self.key_for: TFaceDraft | None = None  # the TFACE whose key-triangle lines may follow
+        self.current: ListDraft | None = None  # the list whose ids may follow
 
     def add_tface(self, tface_id: int, kind: str, tsurf: str, line: int) -> TFaceDraft:
         """A header ``TFACE`` line: the TFACE whose key-triangle lines follow."""
@@ -178,11 +181,15 @@ class ModelDraft:
         )
 
 
-@dataclass
 class SolidTFaceDraft:
-    id: int
-    key: KeyVertices | None = None
-    triangles: list[SolidTriangle] = field(default_factory=list)
+    """A ``TFACE`` of a TSolid MODEL surface while its lines are read."""
+
+    __slots__ = ("id", "key", "triangles")
+
+    def __init__(self, id: int) -> None:
+        self.id = id
+        self.key: KeyVertices | None = None
+        self.triangles: list[SolidTriangle] = []
 
     def add(self, keyword: str, ids: tuple[int, int, int], line: int) -> None:
         """A ``TRGL`` line (one of the TFACE's triangles) or ``KEYVERTICES`` (its key)."""
@@ -193,13 +200,15 @@ class SolidTFaceDraft:
             self.key = triangle
 
 
-@dataclass
 class SolidDraft:
     """A TSolid's MODEL section while its lines are read; :meth:`freeze` gives the record."""
 
-    in_model: bool = False
-    surfaces: list[tuple[str, list[SolidTFaceDraft]]] = field(default_factory=list)
-    regions: list[ModelRegion] = field(default_factory=list)
+    __slots__ = ("in_model", "regions", "surfaces")
+
+    def __init__(self) -> None:
+        self.in_model = False
+        self.surfaces: list[tuple[str, list[SolidTFaceDraft]]] = []
+        self.regions: list[ModelRegion] = []
 
     def add_tface(self, tface_id: int) -> None:
         """A ``TFACE`` of the last ``SURFACE``."""

@@ -324,8 +324,7 @@ def _corner_closed_chains(
     return True
 
 
-@dataclass(frozen=True)
-class _Links:
+class _Links(NamedTuple):
     """Corners (per vertex), vertex ranks and how the arc edges continue each other."""
 
     corner: BoolArray
@@ -389,8 +388,7 @@ def _walk_chains(links: _Links, heads: IntArray, n: int) -> IntArray:
     return ordered
 
 
-@dataclass(frozen=True)
-class _Walk:
+class _Walk(NamedTuple):
     """Arc edges in walk order, split into arcs, each edge directed along its arc."""
 
     ordered: IntArray  # arc-edge positions in walk order

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -242,8 +242,7 @@ def block_orientations(
     return out
 
 
-@dataclass(frozen=True)
-class _PatchVolumes:
+class _PatchVolumes(NamedTuple):
     """Six times each patch's share of the signed volume of a closed shell through it (its
     triangles about one origin, as a shell on the patch's negative side lists them), its
     triangle count, and what bounds the rounding of a shell's sum."""
