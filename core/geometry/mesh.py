@@ -517,7 +517,7 @@ def is_consistently_oriented(faces: ArrayLike) -> bool:
     False
     """
     f = _as_faces(faces, "is_consistently_oriented")
-    if f.size >= RADIX_MIN and int(f.max()) < 1 << 16 and int(f.min()) >= 0:
+    if f.size >= RADIX_MIN and int(f.max()) < 1 << 16:  # indices are >= 0
         # sides ordered by (start, end) in two radix passes of their 16-bit vertices
         start = f.astype(np.uint16).reshape(-1)
         end = _following(f).astype(np.uint16).reshape(-1)
