@@ -102,7 +102,8 @@ def test_patch_edges_of_the_arcs_incidence_are_those_of_the_sort(step: int) -> N
     for scene in _models():
         surfaces = {int(s.id or 0): s for s in scene.surfaces}
         joined = corners_and_arcs_of(surfaces, scene.topology.patches)[3]
-        assert joined is not None and joined.incidence is not None
+        assert joined is not None
+        assert joined.incidence is not None
         bounds = np.searchsorted(joined.owners, np.arange(len(joined.patches) + 1))
         index_of = np.full(len(joined.patches), -1, dtype=np.int64)
         triangles_of = {}
@@ -116,11 +117,13 @@ def test_patch_edges_of_the_arcs_incidence_are_those_of_the_sort(step: int) -> N
         found = patch_edges_of_incidence(
             list(triangles_of), index_of, joined.triangles, joined.incidence, n_points
         )
-        assert expected is not None and found is not None
+        assert expected is not None
+        assert found is not None
         assert found.position == expected.position
         for name in expected._fields[1:]:
             mine, theirs = getattr(found, name), getattr(expected, name)
-            assert mine.dtype == theirs.dtype and np.array_equal(mine, theirs), (scene.name, name)
+            assert mine.dtype == theirs.dtype, (scene.name, name)
+            assert np.array_equal(mine, theirs), (scene.name, name)
         checked += 1
         conflicts += int(expected.own_conflict.any())
         if len(triangles_of) < 2:
@@ -133,4 +136,5 @@ def test_patch_edges_of_the_arcs_incidence_are_those_of_the_sort(step: int) -> N
             )
             is None
         )
-    assert checked > 3 and conflicts  # some patches use an own edge twice one way
+    assert checked > 3
+    assert conflicts  # some patches use an own edge twice one way
