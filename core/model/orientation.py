@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -242,7 +242,8 @@ def block_orientations(
     return out
 
 
-class _PatchVolumes(NamedTuple):
+@dataclass(frozen=True)
+class _PatchVolumes:
     """Six times each patch's share of the signed volume of a closed shell through it (its
     triangles about one origin, as a shell on the patch's negative side lists them), its
     triangle count, and what bounds the rounding of a shell's sum."""
