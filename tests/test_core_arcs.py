@@ -117,3 +117,28 @@ def test_free_border_touching_another_surface_gets_a_corner() -> None:
 def test_negative_tolerance_is_rejected(bad: float) -> None:
     with pytest.raises(ValueError, match="tolerance"):
         build_corners_and_arcs(_two_squares(0.0), tolerance=bad)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_touching_pairs_by_table_are_those_by_sort(seed: int) -> None:
+    """The (vertex, patch) pairs of the arc vertices: marked in a table or sorted, the same."""
+    from geobrep.model import arcs
+
+    rng = np.random.default_rng(seed)
+    n_vertices, n_patches = 500, 7
+    ends = rng.integers(0, n_vertices, (3_000, 2))
+    patch = rng.integers(0, n_patches, 3_000)
+    on_arc = rng.random(n_vertices) < 0.3
+    table = arcs._touching_pairs(ends, patch, on_arc, n_patches)
+    keys = [ends[on_arc[ends[:, c]], c] * n_patches + patch[on_arc[ends[:, c]]] for c in (0, 1)]
+    expected = np.unique(np.concatenate(keys))
+    np.testing.assert_array_equal(table[0], expected // n_patches)
+    np.testing.assert_array_equal(table[1], expected % n_patches)
+    # a table far larger than the pairs: sorted instead, the same pairs
+    wide = arcs._touching_pairs(ends[:5], patch[:5], on_arc, 100_000)
+    keys = [
+        ends[:5][on_arc[ends[:5, c]], c] * 100_000 + patch[:5][on_arc[ends[:5, c]]] for c in (0, 1)
+    ]
+    expected = np.unique(np.concatenate(keys))
+    np.testing.assert_array_equal(wide[0], expected // 100_000)
+    np.testing.assert_array_equal(wide[1], expected % 100_000)

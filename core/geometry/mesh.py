@@ -22,10 +22,12 @@ from geobrep.geometry.graph import (
     hashed_order,
 )
 from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
+from geobrep.geometry.sorting import RADIX_MIN, digit_order, radix_order, radix_pays, sorted_keys
 
 __all__ = [
     "boundary_edges",
     "compact_indices",
+    "csr_row_positions",
     "edge_face_counts",
     "edge_face_incidence",
     "face_areas",
@@ -401,6 +403,8 @@ def edge_face_incidence(faces: ArrayLike) -> tuple[IntArray, IntArray, IntArray,
     m, k = f.shape
     vertex_bits = max(int(f.max(initial=0)).bit_length(), 1)
     side_bits = max((m * k - 1).bit_length(), 1)
+    if m and radix_pays(m * k, 2 * vertex_bits) and not _in_runs(f):
+        return _incidence_by_radix(f, vertex_bits)
     if m and 2 * vertex_bits + side_bits <= 63:
         return _incidence_by_bits(f, vertex_bits, side_bits)
     edges, offsets, perm, _ = _edge_groups(f)
@@ -410,6 +414,55 @@ def edge_face_incidence(faces: ArrayLike) -> tuple[IntArray, IntArray, IntArray,
 
 #: Faces keyed at a time (temporaries that stay in cache).
 _KEY_ROWS = 32_768
+
+
+def _in_runs(faces: IntArray) -> bool:
+    """Whether the faces come mostly in runs of ascending first vertices, as a generated grid
+    and a soup of such surfaces do (checked on the first 65,536): numpy's stable sort
+    (timsort) then merges the runs of their edge keys, faster than radix passes (1M layer-cake
+    triangles 58 against 191 ms CPU); modelA4's 49k faces, in no such order, 6.0 against 3.6.
+    """
+    head = faces[: 1 << 16, 0]
+    return bool(np.count_nonzero(head[1:] < head[:-1]) < 0.25 * head.shape[0])
+
+
+def _incidence_by_radix(
+    faces: IntArray, vertex_bits: int
+) -> tuple[IntArray, IntArray, IntArray, IntArray]:
+    """:func:`edge_face_incidence` from the stable radix order of the sides' edge keys (low
+    vertex, high vertex), which lists the sides of an edge in position order as
+    :func:`_incidence_by_bits` does."""
+    k = faces.shape[1]
+    low = _following(faces)
+    high = np.maximum(faces, low)
+    np.minimum(faces, low, out=low)
+    if vertex_bits <= 16:  # the vertices are the two digits
+        low16, high16 = low.astype(np.uint16).reshape(-1), high.astype(np.uint16).reshape(-1)
+        position = digit_order(low16, high16)
+        low16, high16 = np.take(low16, position), np.take(high16, position)
+        starts_mask = np.ones(position.shape[0], dtype=np.bool_)
+        np.not_equal(low16[1:], low16[:-1], out=starts_mask[1:])
+        starts_mask[1:] |= high16[1:] != high16[:-1]
+        starts = np.flatnonzero(starts_mask)
+        edges = np.empty((starts.shape[0], 2), dtype=np.int64)
+        edges[:, 0] = np.take(low16, starts)
+        edges[:, 1] = np.take(high16, starts)
+    else:
+        low <<= vertex_bits
+        low |= high
+        keys = low.reshape(-1)
+        position = radix_order(keys, 2 * vertex_bits)
+        ordered = np.take(keys, position)
+        starts_mask = np.ones(ordered.shape[0], dtype=np.bool_)
+        np.not_equal(ordered[1:], ordered[:-1], out=starts_mask[1:])
+        starts = np.flatnonzero(starts_mask)
+        unique_keys = np.take(ordered, starts)
+        edges = np.empty((starts.shape[0], 2), dtype=np.int64)
+        np.right_shift(unique_keys, vertex_bits, out=edges[:, 0])
+        np.bitwise_and(unique_keys, (1 << vertex_bits) - 1, out=edges[:, 1])
+    offsets = np.append(starts, position.shape[0]).astype(np.int64, copy=False)
+    face = position // k
+    return edges, offsets, face, position - face * k
 
 
 def _incidence_by_bits(
@@ -478,7 +531,14 @@ def is_consistently_oriented(faces: ArrayLike) -> bool:
     False
     """
     f = _as_faces(faces, "is_consistently_oriented")
-    s = np.sort(_directed_keys(f))
+    if f.size >= RADIX_MIN and int(f.max()) < 1 << 16:  # indices are >= 0
+        # sides ordered by (start, end) in two radix passes of their 16-bit vertices
+        start = f.astype(np.uint16).reshape(-1)
+        end = _following(f).astype(np.uint16).reshape(-1)
+        order = digit_order(start, end)
+        start, end = np.take(start, order), np.take(end, order)
+        return bool(((start[1:] != start[:-1]) | (end[1:] != end[:-1])).all())
+    s = sorted_keys(_directed_keys(f))
     return bool((s[1:] != s[:-1]).all())
 
 
@@ -557,6 +617,23 @@ def compact_indices(indices: ArrayLike, n: int) -> tuple[IntArray, IntArray]:
     present[arr.reshape(-1)] = True
     rank = np.cumsum(present, dtype=np.int64) - 1
     return np.flatnonzero(present).astype(np.int64), rank[arr]
+
+
+def csr_row_positions(offsets: IntArray, rows: IntArray) -> tuple[IntArray, IntArray]:
+    """Flat positions of the CSR rows ``rows`` (row ``r`` holds ``offsets[r]:offsets[r + 1]``)
+    and the row (index into ``rows``) of each.
+
+    >>> positions, row = csr_row_positions(np.array([0, 2, 2, 5]), np.array([2, 0]))
+    >>> positions.tolist(), row.tolist()
+    ([2, 3, 4, 0, 1], [0, 0, 0, 1, 1])
+    """
+    starts = offsets[rows]
+    counts = offsets[rows + 1] - starts
+    owner = np.repeat(np.arange(rows.shape[0], dtype=np.int64), counts)
+    within = np.arange(owner.shape[0], dtype=np.int64) - np.repeat(
+        np.cumsum(counts) - counts, counts
+    )
+    return np.repeat(starts, counts) + within, owner
 
 
 def merge_close_vertices(vertices: ArrayLike, tolerance: float) -> tuple[FloatArray, IntArray]:

@@ -9,7 +9,7 @@ once: each shell is then a few slices of them.
 from __future__ import annotations
 
 from collections.abc import Iterator
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -18,6 +18,9 @@ from geobrep.geometry.arrays import BoolArray, FloatArray, IntArray
 from geobrep.model.entities import Block, Surface
 from geobrep.model.scene import RELATIVE_MERGE_TOLERANCE, Scene
 
+if TYPE_CHECKING:
+    from geobrep.model.arcs import JoinedIncidence
+
 __all__ = [
     "PatchEdges",
     "Shell",
@@ -25,6 +28,7 @@ __all__ = [
     "block_shells",
     "open_edges_if_one_way",
     "patch_edges",
+    "patch_edges_of_incidence",
     "patch_triangles",
 ]
 
@@ -141,7 +145,7 @@ def patch_edges(triangles_of: dict[int, IntArray], n_points: int) -> PatchEdges 
     ids = list(triangles_of)
     n_patches = max(len(ids), 1)
     n = max(n_points, 1)
-    if float(n) * n * n_patches * 2 >= 2.0**62:
+    if not _keys_fit(n, n_patches):
         return None
     counts = np.array([triangles_of[i].shape[0] for i in ids], dtype=np.int64)
     triangles = (
@@ -155,43 +159,99 @@ def patch_edges(triangles_of: dict[int, IntArray], n_points: int) -> PatchEdges 
     ordered = np.sort(((edge * n_patches + patch) << 1) | (start > end))
     pair = ordered >> 1  # edge * n_patches + patch
     edge = pair // n_patches
-    patch = pair - edge * n_patches
-    same_pair = pair[1:] == pair[:-1]
-    same_edge = edge[1:] == edge[:-1]
+    return _grouped_patch_edges(ids, edge, pair - edge * n_patches, (ordered & 1).astype(np.bool_))
+
+
+def patch_edges_of_incidence(
+    ids: list[int], index_of: IntArray, faces: IntArray, incidence: JoinedIncidence, n_points: int
+) -> PatchEdges | None:
+    """:func:`patch_edges` from the incidence of the joined triangles ``faces`` (no sort): the
+    patches are ``ids``, patch ``p`` of the incidence is ``ids[index_of[p]]`` (-1: none of
+    them). ``index_of`` must ascend over the patches it keeps (so that each edge's triangles
+    list them in order); None when it does not, or when :func:`patch_edges` gives None.
+
+    An inner edge (two triangles of one patch) is an own edge used by two triangles: it only
+    tells whether they use it the same way. The other edges go through the whole rule."""
+    if not _keys_fit(max(n_points, 1), max(len(ids), 1)):
+        return None
+    listed = index_of[index_of >= 0]
+    if listed.size > 1 and bool((listed[1:] < listed[:-1]).any()):
+        return None
+    edges, offsets, incident, sides, incident_patch, inner = incidence
+    flat = faces.reshape(-1)
+    width = faces.shape[1]
+    pair = np.flatnonzero(inner)
+    at = offsets[pair]
+    pair_patch = index_of[incident_patch[at]]
+    kept = pair_patch >= 0
+    pair, at, pair_patch = pair[kept], at[kept], pair_patch[kept]
+    first = flat[incident[at] * width + sides[at]]
+    second = flat[incident[at + 1] * width + sides[at + 1]]
+    one_way = pair_patch[first == second]  # both triangles start the edge at one vertex
+    # the other edges' triangle sides, by edge then patch
+    others = np.flatnonzero(~inner)
+    positions, row = mesh.csr_row_positions(offsets, others)
+    patch = index_of[incident_patch[positions]]
+    kept_sides = np.flatnonzero(patch >= 0)
+    positions, patch = positions[kept_sides], patch[kept_sides]
+    edge = others[row[kept_sides]]
+    start = flat[incident[positions] * width + sides[positions]]
+    high = edges[edge, 1]
+    # the triangles are proper: every edge joins two vertices, the higher one second
+    key = edges[edge, 0] * max(n_points, 1) + high
+    found = _grouped_patch_edges(ids, key, patch, start == high)
+    if one_way.size:
+        found.own_conflict[one_way] = True
+    return found
+
+
+def _keys_fit(n: int, n_patches: int) -> bool:
+    """Whether :func:`patch_edges`'s side keys fit an int64."""
+    return float(n) * n * n_patches * 2 < 2.0**62
+
+
+def _grouped_patch_edges(
+    ids: list[int], edge: IntArray, patch: IntArray, backward: BoolArray
+) -> PatchEdges:
+    """:class:`PatchEdges` of triangle sides grouped by ``(edge, patch)`` in ascending order
+    (in any order within a group): each side's edge key, patch (index into ``ids``) and
+    whether it runs from the edge's higher vertex."""
+    n_ids = len(ids)
+    n_sides = edge.shape[0]
+    edge_start = np.ones(n_sides, dtype=np.bool_)
+    np.not_equal(edge[1:], edge[:-1], out=edge_start[1:])
+    pair_start = edge_start.copy()
+    pair_start[1:] |= patch[1:] != patch[:-1]
+    # one row per (edge, patch) pair: its sides each way
+    first = np.flatnonzero(pair_start)
+    length = np.diff(np.append(first, n_sides))
+    backward_count = (
+        np.add.reduceat(backward.astype(np.int64), first) if first.size else first.copy()
+    )
+    forward_count = length - backward_count
+    row_patch = patch[first]
     # an edge is shared when its run of sides holds two patches
-    edge_start = np.ones(ordered.shape[0], dtype=np.bool_)
-    np.logical_not(same_edge, out=edge_start[1:])
-    run = np.cumsum(edge_start) - 1
-    shared_run = np.zeros(int(run[-1]) + 1 if run.size else 0, dtype=np.bool_)
-    shared_run[run[1:][same_edge & ~same_pair]] = True
-    shared = shared_run[run]
+    run = np.cumsum(edge_start[first]) - 1
+    shared = np.bincount(run, minlength=int(run[-1]) + 1 if run.size else 0)[run] > 1
     own = ~shared
-    # own edges: used twice one way (the same key twice), or by one triangle (a lone key)
-    twice = np.zeros(ordered.shape[0], dtype=np.bool_)
-    twice[1:] = ordered[1:] == ordered[:-1]
-    lone = np.ones(ordered.shape[0], dtype=np.bool_)
-    lone[1:] &= ~same_pair
-    lone[:-1] &= ~same_pair
-    own_conflict = np.bincount(patch[own & twice], minlength=len(ids)) > 0
-    own_open = np.bincount(patch[own & lone], minlength=len(ids)).astype(np.int64)
+    # own edges: used twice one way, or by one triangle
+    conflict = own & ((forward_count > 1) | (backward_count > 1))
+    own_conflict = np.bincount(row_patch[conflict], minlength=n_ids) > 0
+    own_open = np.bincount(row_patch[own & (length == 1)], minlength=n_ids).astype(np.int64)
     # shared edges: how often each patch uses them each way, by patch
-    sides = np.flatnonzero(shared)
-    rows, row_of = np.unique(pair[sides], return_inverse=True)
-    backward = (ordered[sides] & 1).astype(np.bool_)
-    row_forward = np.bincount(row_of[~backward], minlength=rows.shape[0]).astype(np.int64)
-    row_backward = np.bincount(row_of[backward], minlength=rows.shape[0]).astype(np.int64)
-    row_edge, row_patch = rows // n_patches, rows % n_patches
+    rows = np.flatnonzero(shared)
+    row_patch = row_patch[rows]
     by_patch = np.argsort(row_patch, kind="stable")
-    offsets = np.zeros(len(ids) + 1, dtype=np.int64)
-    np.cumsum(np.bincount(row_patch, minlength=len(ids)), out=offsets[1:])
+    offsets = np.zeros(n_ids + 1, dtype=np.int64)
+    np.cumsum(np.bincount(row_patch, minlength=n_ids), out=offsets[1:])
     return PatchEdges(
         position={patch_id: k for k, patch_id in enumerate(ids)},
         own_conflict=own_conflict,
         own_open=own_open,
         shared_offsets=offsets,
-        shared_key=row_edge[by_patch],
-        shared_forward=row_forward[by_patch],
-        shared_backward=row_backward[by_patch],
+        shared_key=edge[first[rows]][by_patch],
+        shared_forward=forward_count[rows][by_patch].astype(np.int64),
+        shared_backward=backward_count[rows][by_patch].astype(np.int64),
     )
 
 

@@ -60,6 +60,7 @@ from geobrep.model.topology import Arc, Corner, Patch, Topology
 __all__ = [
     "DEFAULT_RELATIVE_TOLERANCE",
     "ArcChains",
+    "JoinedIncidence",
     "JoinedPatches",
     "build_corners_and_arcs",
     "chain_arc_edges",
@@ -107,6 +108,20 @@ class ArcChains:
         )
 
 
+class JoinedIncidence(NamedTuple):
+    """The edge–face incidence of :class:`JoinedPatches` triangles, as
+    :func:`~geobrep.geometry.mesh.edge_face_incidence` gives it, with the patch (position in
+    ``patches``) of each incident triangle and whether each edge is **inner**: used by exactly
+    two triangles of one patch."""
+
+    edges: IntArray
+    offsets: IntArray
+    incident: IntArray
+    sides: IntArray
+    incident_patch: IntArray
+    inner: BoolArray
+
+
 class JoinedPatches(NamedTuple):
     """The patches' triangles once coincident vertices are joined, as
     :func:`corners_and_arcs_of` builds the corners and arcs on them (for a reader that goes on
@@ -115,7 +130,8 @@ class JoinedPatches(NamedTuple):
     ``triangles`` use the ``points`` (joined vertices), triangles the joining collapsed left
     out; ``owners`` (ascending) is the position in ``patches`` of each triangle's patch and
     ``surfaces`` the surface of each patch. ``exact``: every joined point stands for copies of
-    one point only (no two different points were joined).
+    one point only (no two different points were joined). ``incidence``: how the triangles
+    use their edges, when known.
     """
 
     points: NDArray[np.float64]
@@ -125,24 +141,14 @@ class JoinedPatches(NamedTuple):
     surfaces: tuple[Surface, ...]
     tolerance: float
     exact: bool
-
-
-def _segments(offsets: IntArray, rows: IntArray) -> tuple[IntArray, IntArray]:
-    """Flat positions of the CSR rows ``rows`` and the row (index into ``rows``) of each."""
-    starts = offsets[rows]
-    counts = offsets[rows + 1] - starts
-    owner = np.repeat(np.arange(rows.shape[0], dtype=np.int64), counts)
-    within = np.arange(owner.shape[0], dtype=np.int64) - np.repeat(
-        np.cumsum(counts) - counts, counts
-    )
-    return np.repeat(starts, counts) + within, owner
+    incidence: JoinedIncidence | None = None
 
 
 def _multiset_signatures(
     offsets: IntArray, incident_patch: IntArray, arc_edges: IntArray
 ) -> IntArray:
     """An id per arc edge, equal for edges used by the same multiset of patches."""
-    positions, rows = _segments(offsets, arc_edges)
+    positions, rows = mesh.csr_row_positions(offsets, arc_edges)
     counts = np.bincount(rows, minlength=arc_edges.shape[0])
     within = np.arange(rows.shape[0], dtype=np.int64) - np.repeat(
         np.cumsum(counts) - counts, counts
@@ -198,16 +204,10 @@ def _touch_corners(
     on_arc = np.zeros(n_vertices, dtype=np.bool_)
     on_arc[ends.reshape(-1)] = True
     near = np.flatnonzero(on_arc[edges[:, 0]] | on_arc[edges[:, 1]])
-    positions, rows = _segments(offsets, near)
+    positions, rows = mesh.csr_row_positions(offsets, near)
     patch = incident_patch[positions]
     n_patches = int(incident_patch.max()) + 1 if incident_patch.size else 1
-    keys = []
-    for column in (0, 1):
-        vertex = edges[near[rows], column]
-        keep = on_arc[vertex]
-        keys.append(vertex[keep] * n_patches + patch[keep])
-    pairs = _sorted_unique(np.concatenate(keys))
-    vertex, member = pairs // n_patches, pairs % n_patches
+    vertex, member = _touching_pairs(edges[near[rows]], patch, on_arc, n_patches)
     with np.errstate(over="ignore"):
         key = member.astype(np.uint64) + np.uint64(1)
         h1 = np.zeros(n_vertices, dtype=np.uint64)
@@ -219,6 +219,32 @@ def _touch_corners(
     differ = (h1[p] != h1[q]) | (h2[p] != h2[q]) | (count[p] != count[q])
     corner[p[differ & (count[p] >= count[q])]] = True
     corner[q[differ & (count[q] >= count[p])]] = True
+
+
+def _touching_pairs(
+    ends: IntArray, patch: IntArray, on_arc: BoolArray, n_patches: int
+) -> tuple[IntArray, IntArray]:
+    """The distinct ``(vertex, patch)`` pairs, ascending, of the arc vertices (``on_arc``)
+    among the ``ends`` of edges used by triangles of ``patch``: marked in a table of arc
+    vertex by patch when it is not much larger than the pairs, else sorted."""
+    arc_vertices = np.flatnonzero(on_arc)
+    size = arc_vertices.shape[0] * n_patches
+    if size > 8 * ends.size + (1 << 16):
+        keys = []
+        for column in (0, 1):
+            vertex = ends[:, column]
+            keep = on_arc[vertex]
+            keys.append(vertex[keep] * n_patches + patch[keep])
+        pairs = _sorted_unique(np.concatenate(keys))
+        return pairs // n_patches, pairs % n_patches
+    local = np.cumsum(on_arc, dtype=np.int64) - 1
+    touched = np.zeros(size, dtype=np.bool_)
+    for column in (0, 1):
+        vertex = ends[:, column]
+        keep = on_arc[vertex]
+        touched[local[vertex[keep]] * n_patches + patch[keep]] = True
+    pairs = np.flatnonzero(touched)
+    return arc_vertices[pairs // n_patches], pairs % n_patches
 
 
 def _through_pairs(
@@ -299,8 +325,7 @@ def _corner_closed_chains(
     return True
 
 
-@dataclass(frozen=True)
-class _Links:
+class _Links(NamedTuple):
     """Corners (per vertex), vertex ranks and how the arc edges continue each other."""
 
     corner: BoolArray
@@ -364,8 +389,7 @@ def _walk_chains(links: _Links, heads: IntArray, n: int) -> IntArray:
     return ordered
 
 
-@dataclass(frozen=True)
-class _Walk:
+class _Walk(NamedTuple):
     """Arc edges in walk order, split into arcs, each edge directed along its arc."""
 
     ordered: IntArray  # arc-edge positions in walk order
@@ -631,7 +655,7 @@ def _patch_orders(
     arc); an arc whose first edge has a triangle along the axis is left to :func:`_around`."""
     n_arcs = chains.n_arcs
     first = chains.edge_ids[chains.arc_offsets[:-1]]
-    positions, arc_of = _segments(offsets, first)
+    positions, arc_of = mesh.csr_row_positions(offsets, first)
     count = np.diff(offsets)[first]
     members = incident_patch[positions]
     orders: list[IntArray] = np.split(members, np.cumsum(count)[:-1])
@@ -773,6 +797,12 @@ def corners_and_arcs_of(
     if tri.shape[0] == 0:
         return [], [], {}, None
     n_vertices = merged.shape[0]
+    edges, offsets, incident, sides = mesh.edge_face_incidence(tri)
+    incident_patch = owners[incident]
+    counts = np.diff(offsets)
+    inner = counts == 2
+    pair = np.flatnonzero(inner)
+    inner[pair] = incident_patch[offsets[pair]] == incident_patch[offsets[pair] + 1]
     joined = JoinedPatches(
         points=merged,
         triangles=tri,
@@ -781,14 +811,8 @@ def corners_and_arcs_of(
         surfaces=tuple(surfaces[p.surface] for p in patches),
         tolerance=float(tolerance),
         exact=bool(np.array_equal(points, np.take(merged, inverse, axis=0))),
+        incidence=JoinedIncidence(edges, offsets, incident, sides, incident_patch, inner),
     )
-
-    edges, offsets, incident, sides = mesh.edge_face_incidence(tri)
-    incident_patch = owners[incident]
-    counts = np.diff(offsets)
-    inner = counts == 2
-    pair = np.flatnonzero(inner)
-    inner[pair] = incident_patch[offsets[pair]] == incident_patch[offsets[pair] + 1]
     hints = None
     if extra_corners is not None:
         wanted = np.asarray(extra_corners, dtype=np.float64).reshape(-1, 3)

@@ -40,6 +40,7 @@ from geobrep.model._shells import (
     block_shell,
     open_edges_if_one_way,
     patch_edges,
+    patch_edges_of_incidence,
     patch_triangles,
 )
 from geobrep.model.entities import Block, PatchSide, Surface
@@ -306,6 +307,7 @@ def _standing_on_joined(
     surfaces = {scene.topology.patch(s.patch).surface for b in blocks for s in b.sides}
     bounds = np.searchsorted(joined.owners, np.arange(len(joined.patches) + 1)).tolist()
     triangles_of: dict[int, IntArray] = {}
+    index_of = np.full(len(joined.patches), -1, dtype=np.int64)  # joined -> triangles_of
     for patch in scene.topology.patches:  # the patches patch_triangles gives triangles to
         if patch.surface not in surfaces:
             continue
@@ -317,8 +319,20 @@ def _standing_on_joined(
             joined.surfaces[k] is not scene.get(patch.surface)
         ):
             return None
+        index_of[k] = len(triangles_of)
         triangles_of[patch.id] = joined.triangles[bounds[k] : bounds[k + 1]]
-    edges = patch_edges(triangles_of, int(joined.points.shape[0]))
+    n_points = int(joined.points.shape[0])
+    edges = None
+    if joined.incidence is not None:  # the corners' and arcs' incidence: no sort again
+        edges = patch_edges_of_incidence(
+            list(triangles_of),
+            index_of,
+            joined.triangles,
+            joined.incidence,
+            n_points,
+        )
+    if edges is None:
+        edges = patch_edges(triangles_of, n_points)
     _, volumes = _patch_measures(joined.points, triangles_of, with_volumes=True, with_areas=False)
     if edges is None or volumes is None:
         return None

@@ -14,7 +14,14 @@ from shapes import make_cube
 import geobrep
 from geobrep import Block, PatchSide, Scene
 from geobrep.geometry.mesh import boundary_edges, is_consistently_oriented
-from geobrep.model._shells import block_shell, open_edges_if_one_way, patch_edges, patch_triangles
+from geobrep.model._shells import (
+    block_shell,
+    open_edges_if_one_way,
+    patch_edges,
+    patch_edges_of_incidence,
+    patch_triangles,
+)
+from geobrep.model.arcs import corners_and_arcs_of
 from geobrep.model.orientation import _one_way_orientation, _patch_areas, _shell_orientation
 from geobrep.model.topology import Patch, Topology
 
@@ -85,3 +92,49 @@ def test_patch_edges_answer_as_the_whole_shell(seed: int) -> None:
     assert one_way  # shells that run one way
     assert turned  # and shells with triangles to turn
     assert own_open  # and edges bounding one triangle that no other patch has
+
+
+@pytest.mark.parametrize("step", [1, 3])
+def test_patch_edges_of_the_arcs_incidence_are_those_of_the_sort(step: int) -> None:
+    """Summarised from the incidence the corners and arcs were found on (every patch, or the
+    patches but every third one), the edges are the ones the sort of their keys gives."""
+    checked = conflicts = 0
+    for scene in _models():
+        surfaces = {int(s.id or 0): s for s in scene.surfaces}
+        joined = corners_and_arcs_of(surfaces, scene.topology.patches)[3]
+        assert joined is not None
+        assert joined.incidence is not None
+        bounds = np.searchsorted(joined.owners, np.arange(len(joined.patches) + 1))
+        index_of = np.full(len(joined.patches), -1, dtype=np.int64)
+        triangles_of = {}
+        for k, patch in enumerate(joined.patches):
+            if step > 1 and k % step == 1:
+                continue
+            index_of[k] = len(triangles_of)
+            triangles_of[patch.id] = joined.triangles[bounds[k] : bounds[k + 1]]
+        n_points = int(joined.points.shape[0])
+        expected = patch_edges(triangles_of, n_points)
+        found = patch_edges_of_incidence(
+            list(triangles_of), index_of, joined.triangles, joined.incidence, n_points
+        )
+        assert expected is not None
+        assert found is not None
+        assert found.position == expected.position
+        for name in expected._fields[1:]:
+            mine, theirs = getattr(found, name), getattr(expected, name)
+            assert mine.dtype == theirs.dtype, (scene.name, name)
+            assert np.array_equal(mine, theirs), (scene.name, name)
+        checked += 1
+        conflicts += int(expected.own_conflict.any())
+        if len(triangles_of) < 2:
+            continue
+        # patches out of order: left to the sort
+        backwards = np.where(index_of >= 0, len(triangles_of) - 1 - index_of, -1)
+        assert (
+            patch_edges_of_incidence(
+                list(triangles_of), backwards, joined.triangles, joined.incidence, n_points
+            )
+            is None
+        )
+    assert checked > 3
+    assert conflicts  # some patches use an own edge twice one way
