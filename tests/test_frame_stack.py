@@ -1,4 +1,4 @@
-"""geobrep._frame_stack: a call run with room on the frame stack behaves as the call itself."""
+"""geobrep.cli._frame_stack: a call run with room on the frame stack behaves as the call itself."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from geobrep._frame_stack import ROOM_WORDS, _reserved, call_with_room
+from geobrep.cli._frame_stack import ROOM_WORDS, _reserved, call_with_room
 from geobrep.cli.main import main
 
 

@@ -17,8 +17,8 @@ import traceback
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
-from geobrep._frame_stack import call_with_room
 from geobrep.cli._blas_threads import one_blas_thread
+from geobrep.cli._frame_stack import call_with_room
 from geobrep.cli.commands import COMMANDS, Command
 from geobrep.cli.common import EXIT_EMPTY, CliParser, EmptyResultError, WarningLines, add_verbosity
 from geobrep.errors import GeobrepError
@@ -186,7 +186,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     Warnings raised meanwhile are printed as short ``warning:`` lines (see
     :class:`~geobrep.cli.common.WarningLines`), after the command's output and before its error.
-    The command runs with room on the frame stack (:mod:`geobrep._frame_stack`): however deep
+    The command runs with room on the frame stack (:mod:`geobrep.cli._frame_stack`): however deep
     the caller, no loop of it maps and unmaps a frame chunk per call.
     """
     _freeze_heap_at_exit()
