@@ -355,14 +355,15 @@ def _concat_points(arrays: list[NDArray[np.float64]]) -> NDArray[np.float64]:
 # -- layout -> scene ---------------------------------------------------------------------------
 
 
+# (their schemas are built when a header is first checked: a file without one needs none)
 class _PropertyRecord(BaseModel):
-    model_config = ConfigDict(extra="allow")
+    model_config = ConfigDict(extra="allow", defer_build=True)
     array: str
     dtype: str
 
 
 class _EntityRecord(BaseModel):
-    model_config = ConfigDict(extra="allow")
+    model_config = ConfigDict(extra="allow", defer_build=True)
     id: int
     type: Literal["PointSet", "PolyLine", "Surface", "TetMesh"]
     points: tuple[NonNegativeInt, NonNegativeInt]
@@ -373,7 +374,7 @@ class _EntityRecord(BaseModel):
 
 
 class _HeaderRecord(BaseModel):
-    model_config = ConfigDict(extra="allow")
+    model_config = ConfigDict(extra="allow", defer_build=True)
     entities: list[_EntityRecord] = []
     groups: list[dict[str, Any]] = []
 

@@ -79,7 +79,7 @@ CAPABILITIES: dict[str, FormatCapabilities] = {
 class VtuOptions(BaseModel):
     """Options of the ``vtu`` writer."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", defer_build=True)
 
     compression: Literal["zlib", "lzma"] | None = None
     """Compress the binary arrays (smaller files, slower)."""
@@ -88,7 +88,7 @@ class VtuOptions(BaseModel):
 class LegacyVtkOptions(BaseModel):
     """Options of the legacy ``vtk`` writer."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", defer_build=True)
 
     binary: bool = True
     """Big-endian binary arrays; False writes ASCII."""
@@ -97,7 +97,7 @@ class LegacyVtkOptions(BaseModel):
 class StlOptions(BaseModel):
     """Options of the ``stl`` writer."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", defer_build=True)
 
     binary: bool = False
     """Binary STL stores coordinates as float32 (UTM coordinates lose centimetres); the

@@ -183,7 +183,8 @@ class Scene(FrozenModel):
             "entities": entities,
             "groups": groups,
             "crs": crs,
-            "topology": topology if topology is not None else Topology(),
+            # the empty topology Topology() validates to (its schema is built on first use)
+            "topology": topology if topology is not None else Topology.model_construct(),
             "name": name,
             "metadata": metadata if metadata is not None else {},
         }
