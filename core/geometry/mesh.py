@@ -452,14 +452,7 @@ def _incidence_by_radix(
         low |= high
         keys = low.reshape(-1)
         position = radix_order(keys, 2 * vertex_bits)
-        ordered = np.take(keys, position)
-        starts_mask = np.ones(ordered.shape[0], dtype=np.bool_)
-        np.not_equal(ordered[1:], ordered[:-1], out=starts_mask[1:])
-        starts = np.flatnonzero(starts_mask)
-        unique_keys = np.take(ordered, starts)
-        edges = np.empty((starts.shape[0], 2), dtype=np.int64)
-        np.right_shift(unique_keys, vertex_bits, out=edges[:, 0])
-        np.bitwise_and(unique_keys, (1 << vertex_bits) - 1, out=edges[:, 1])
+        return _incidence_of_sorted(np.take(keys, position), position, vertex_bits, k)
     offsets = np.append(starts, position.shape[0]).astype(np.int64, copy=False)
     face = position // k
     return edges, offsets, face, position - face * k
@@ -493,14 +486,22 @@ def _incidence_by_bits(
     mask = (1 << side_bits) - 1
     position = flat & mask
     flat >>= side_bits  # the edge keys, ascending
-    starts_mask = np.ones(flat.shape[0], dtype=np.bool_)
-    np.not_equal(flat[1:], flat[:-1], out=starts_mask[1:])
+    return _incidence_of_sorted(flat, position, vertex_bits, k)
+
+
+def _incidence_of_sorted(
+    ordered: IntArray, position: IntArray, vertex_bits: int, k: int
+) -> tuple[IntArray, IntArray, IntArray, IntArray]:
+    """:func:`edge_face_incidence` from the sides' edge keys (low vertex, high vertex) in
+    ascending order and the position (face * k + corner) of each."""
+    starts_mask = np.ones(ordered.shape[0], dtype=np.bool_)
+    np.not_equal(ordered[1:], ordered[:-1], out=starts_mask[1:])
     starts = np.flatnonzero(starts_mask)
-    unique_keys = np.take(flat, starts)
+    unique_keys = np.take(ordered, starts)
     edges = np.empty((starts.shape[0], 2), dtype=np.int64)
     np.right_shift(unique_keys, vertex_bits, out=edges[:, 0])
     np.bitwise_and(unique_keys, (1 << vertex_bits) - 1, out=edges[:, 1])
-    offsets = np.append(starts, flat.shape[0]).astype(np.int64, copy=False)
+    offsets = np.append(starts, ordered.shape[0]).astype(np.int64, copy=False)
     face = position // k
     return edges, offsets, face, position - face * k
 
