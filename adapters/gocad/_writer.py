@@ -755,13 +755,9 @@ def _patch_vertices(surface: Surface) -> tuple[NDArray[np.int64], NDArray[np.int
     return unique_keys, corners.reshape(faces.shape)
 
 
-def tface_copies_sentence(surface: Surface, n_points: int | None = None) -> str:
-    """What writing ``surface`` with a vertex of its own in each TFACE does to it (the
-    format's losses and the writer's warning say it alike)."""
-    if n_points is None:
-        split = _patch_vertices(surface)
-        used = np.unique(np.asarray(surface.faces)).shape[0]
-        n_points = surface.n_vertices + (0 if split is None else split[0].shape[0] - used)
+def tface_copies_sentence(surface: Surface, n_points: int) -> str:
+    """What writing ``surface`` with a vertex of its own in each TFACE does to it: ``n_points``
+    points read back (the format's losses and the writer's warning say it alike)."""
     return (
         f"{surface.label}: {n_points - surface.n_vertices} copies of vertices its patches share "
         "are written, one in each TFACE that uses them (ATOM lines, as GOCAD writes a Model3d; "
@@ -771,7 +767,14 @@ def tface_copies_sentence(surface: Surface, n_points: int | None = None) -> str:
 
 def model3d_copies(scene: Scene) -> list[str]:
     """:func:`tface_copies_sentence` of each surface a Model3d write gives copies to."""
-    return [tface_copies_sentence(s) for s in scene.surfaces if _patch_vertices(s) is not None]
+    sentences = []
+    for surface in scene.surfaces:
+        split = _patch_vertices(surface)
+        if split is not None:  # copies + the vertices no triangle uses
+            used = np.unique(split[0] % surface.n_vertices).shape[0]
+            n_points = split[0].shape[0] + surface.n_vertices - used
+            sentences.append(tface_copies_sentence(surface, n_points))
+    return sentences
 
 
 def _own_tface_vertices(surface: Surface) -> Surface:
@@ -790,7 +793,6 @@ def _own_tface_vertices(surface: Surface) -> Surface:
         return surface  # each vertex is in one patch already
     unique_keys, new_faces = split
     n = surface.n_vertices
-    faces = np.asarray(surface.faces)
     copied = unique_keys % n
     used = np.zeros(n, dtype=np.bool_)
     used[copied] = True
@@ -798,7 +800,7 @@ def _own_tface_vertices(surface: Surface) -> Surface:
     report(tface_copies_sentence(surface, source.shape[0]))
     changes: dict[str, Any] = {
         "vertices": np.asarray(surface.vertices)[source],
-        "faces": new_faces.reshape(faces.shape),
+        "faces": new_faces,
         "point_data": surface.point_data.take(source),
     }
     meta = gocad_metadata(surface)
