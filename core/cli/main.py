@@ -198,10 +198,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _one_blas_thread_suffices(argv: Sequence[str]) -> bool:
     """Whether the command line runs a built-in command that solves no large dense system (or
     none: help, version, a usage error). A plugin's command keeps OpenBLAS's threads."""
-    words = [word for word in argv if not word.startswith("-")]
-    if not words:
+    word = _command_word(argv)
+    if word is None:
         return True
-    chosen = next((c for c in COMMANDS if c.name == words[0]), None)
+    chosen = next((c for c in COMMANDS if c.name == word), None)
     return chosen is not None and not chosen.dense_linear_algebra
 
 
@@ -225,9 +225,13 @@ def _uses_plugins(argv: Sequence[str]) -> bool:
     question alone scans every installed distribution's entry points (~3.5 ms) and loading
     the host scans them again. A help request does not load it.
     """
-    words = [word for word in argv if not word.startswith("-")]
     asks_help = any(word in ("-h", "--help") for word in argv)
-    return bool(words) and words[0] in _HOST_COMMANDS and not asks_help
+    return _command_word(argv) in _HOST_COMMANDS and not asks_help
+
+
+def _command_word(argv: Sequence[str]) -> str | None:
+    """The first word of the command line that is no option: the command's name, if any."""
+    return next((word for word in argv if not word.startswith("-")), None)
 
 
 def _freeze_heap_at_exit() -> None:
