@@ -178,24 +178,29 @@ def patch_edges_of_incidence(
     if listed.size > 1 and bool((listed[1:] < listed[:-1]).any()):
         return None
     edges, offsets, incident, sides, incident_patch, inner = incidence
-    flat = faces.reshape(-1)
-    width = faces.shape[1]
+    # the vertex each incident triangle side starts at, in incidence order (one gather of the
+    # faces for all the sides rather than one per use)
+    side_start = np.take(faces.reshape(-1), incident * faces.shape[1] + sides)
+    every = bool(listed.shape[0] == index_of.shape[0])  # no patch of the incidence left out
     pair = np.flatnonzero(inner)
     at = offsets[pair]
-    pair_patch = index_of[incident_patch[at]]
-    kept = pair_patch >= 0
-    pair, at, pair_patch = pair[kept], at[kept], pair_patch[kept]
-    first = flat[incident[at] * width + sides[at]]
-    second = flat[incident[at + 1] * width + sides[at + 1]]
-    one_way = pair_patch[first == second]  # both triangles start the edge at one vertex
+    pair_patch = np.take(index_of, np.take(incident_patch, at))
+    if not every:
+        kept = pair_patch >= 0
+        pair, at, pair_patch = pair[kept], at[kept], pair_patch[kept]
+    # both triangles start the edge at one vertex
+    one_way = pair_patch[np.take(side_start, at) == np.take(side_start, at + 1)]
     # the other edges' triangle sides, by edge then patch
     others = np.flatnonzero(~inner)
     positions, row = mesh.csr_row_positions(offsets, others)
-    patch = index_of[incident_patch[positions]]
-    kept_sides = np.flatnonzero(patch >= 0)
-    positions, patch = positions[kept_sides], patch[kept_sides]
-    edge = others[row[kept_sides]]
-    start = flat[incident[positions] * width + sides[positions]]
+    patch = np.take(index_of, np.take(incident_patch, positions))
+    if every:
+        edge = np.take(others, row)
+    else:
+        kept_sides = np.flatnonzero(patch >= 0)
+        positions, patch = positions[kept_sides], patch[kept_sides]
+        edge = others[row[kept_sides]]
+    start = np.take(side_start, positions)
     high = edges[edge, 1]
     # the triangles are proper: every edge joins two vertices, the higher one second
     key = edges[edge, 0] * max(n_points, 1) + high
