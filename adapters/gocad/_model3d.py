@@ -397,12 +397,20 @@ def _rebuilt_topology(
     )
     if warn is not None:
         warn_idle_bstones(surfaces, corners, tolerance, warn)
+    # The patches were validated when matched; what is added to them here is made from
+    # checked data (arc ids numbered from 0, block ids of validated blocks, or None), so
+    # each copy is built as its validation would leave it.
+    fields = tuple(Patch.model_fields)
     topology = Topology(
         corners=tuple(corners),
         arcs=tuple(arcs),
         patches=tuple(
-            p.model_copy(
-                update={"arcs": tuple(patch_arcs.get(p.id, ())), **(updates or {}).get(p.id, {})}
+            Patch.model_construct(
+                **{
+                    **{name: getattr(p, name) for name in fields},
+                    "arcs": tuple(patch_arcs.get(p.id, ())),
+                    **(updates or {}).get(p.id, {}),
+                }
             )
             for p in patches
         ),
@@ -511,8 +519,13 @@ def warn_idle_bstones(
             continue
         at = surface.vertices[np.asarray(stones, dtype=np.int64)]
         if points.shape[0]:
-            gaps = np.abs(at[:, None, :] - points[None, :, :]).max(axis=2).min(axis=1)
-            idle = [int(v) for v, gap in zip(stones, gaps, strict=True) if gap > tolerance]
+            # the largest coordinate gap to each corner (a coordinate at a time: a reduction
+            # over an axis of 3 is slow), the smallest over the corners
+            gap = np.abs(at[:, 0:1] - points[:, 0])
+            np.maximum(gap, np.abs(at[:, 1:2] - points[:, 1]), out=gap)
+            np.maximum(gap, np.abs(at[:, 2:3] - points[:, 2]), out=gap)
+            far = np.flatnonzero(gap.min(axis=1) > tolerance).tolist()
+            idle = [int(stones[k]) for k in far]
         else:
             idle = [int(v) for v in stones]
         if idle:
