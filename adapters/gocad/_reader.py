@@ -33,9 +33,10 @@ from geobrep.adapters.gocad._tables import IdLookup, ResolvedVertices
 from geobrep.adapters.gocad.options import GocadOptions
 from geobrep.errors import EntityValidationError, FormatError, TopologyError
 from geobrep.host.capabilities import SKIPPED_ON_READ
+from geobrep.model.arrays import as_readonly
 from geobrep.model.crs import CRS
 from geobrep.model.entities import Entity, PointSet, PolyLine, Surface
-from geobrep.model.properties import Property
+from geobrep.model.properties import Property, PropertyMap
 from geobrep.model.scene import Group, Scene
 
 if TYPE_CHECKING:
@@ -378,15 +379,7 @@ class _Builder:
             self._hints(obj, lookup, fields)
             self._warn_inner_borders(obj, index, parts, fields)
             self.entities.append(
-                Surface(
-                    vertices=xyz,
-                    faces=index,
-                    patch_labels=parts,
-                    patch_names=names or ("0",),
-                    point_data=point_data,
-                    cell_data=cell_data,
-                    **fields,
-                )
+                _surface(xyz, index, parts, names or ("0",), point_data, cell_data, fields)
             )
         elif obj.type == "PLine":
             self.entities.append(
@@ -735,6 +728,59 @@ class _Builder:
                 },
             )
         )
+
+
+def _surface(
+    xyz: NDArray[np.float64],
+    faces: NDArray[np.int64],
+    labels: NDArray[np.int64],
+    names: tuple[str, ...],
+    point_data: dict[str, Property],
+    cell_data: dict[str, Property],
+    fields: _EntityFields,
+) -> Surface:
+    """The Surface of a TSurf, built as its validation would build it when the reader made
+    its parts so (float64 (N, 3) finite vertices, int64 (M, 3) faces of vertex indices the
+    id lookup resolved, int64 (M,) labels, validated properties under non-empty names,
+    JSON metadata of text, numbers and lists): the entity's own checks (vertex indices,
+    labels against the patch names, property lengths) are still run, with its errors.
+    Anything else goes through the validating constructor."""
+    made_so = (
+        xyz.dtype == np.float64
+        and xyz.ndim == 2
+        and xyz.shape[1] == 3
+        and faces.dtype == np.int64
+        and faces.ndim == 2
+        and faces.shape[1] == 3
+        and labels.dtype == np.int64
+        and labels.shape == (faces.shape[0],)
+        and all(
+            isinstance(name, str) and name and isinstance(prop, Property)
+            for data in (point_data, cell_data)
+            for name, prop in data.items()
+        )
+    )
+    if not made_so:
+        return Surface(
+            vertices=xyz,
+            faces=faces,
+            patch_labels=labels,
+            patch_names=names,
+            point_data=point_data,
+            cell_data=cell_data,
+            **fields,
+        )
+    surface = Surface.model_construct(
+        vertices=as_readonly(xyz),
+        faces=as_readonly(faces),
+        patch_labels=as_readonly(labels),
+        patch_names=names,
+        point_data=PropertyMap(point_data),
+        cell_data=PropertyMap(cell_data),
+        **fields,
+    )
+    surface.check_fields()
+    return surface
 
 
 def _majority_names(obj: GocadObject, component: NDArray[np.int64], count: int) -> list[str]:

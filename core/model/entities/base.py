@@ -95,10 +95,16 @@ class Entity(FrozenModel):
     def _check(self) -> None:
         """Cross-field checks of a subclass; raise :meth:`fail` errors."""
 
-    @model_validator(mode="after")
-    def _validate_entity(self) -> Self:
-        if getattr(self, "_checked", False):
-            return self
+    def check_fields(self) -> None:
+        """Run the cross-field checks validation runs (raising its
+        :class:`~geobrep.errors.EntityValidationError`) and mark the entity checked: for an
+        entity made with ``model_construct`` from fields that already have their validated
+        form (read-only arrays of the field's dtype and shape, a PropertyMap, JSON metadata)."""
+        if not getattr(self, "_checked", False):
+            self._cross_checks()
+        self._checked = True
+
+    def _cross_checks(self) -> None:
         self._check()
         for field, props, count, noun in (
             ("point_data", self.point_data, self.n_points, "points"),
@@ -109,6 +115,11 @@ class Entity(FrozenModel):
                     raise self.fail(
                         f"{field}[{name!r}]", f"has {len(prop)} values for {count} {noun}"
                     )
+
+    @model_validator(mode="after")
+    def _validate_entity(self) -> Self:
+        if not getattr(self, "_checked", False):
+            self._cross_checks()
         return self
 
     @property
