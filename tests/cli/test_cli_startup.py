@@ -56,6 +56,8 @@ print(json.dumps(found))
 NOT_FOR_HELP = (
     "importlib.metadata",
     "email",
+    "difflib",  # for a mistyped word only
+    "traceback",  # for GEOBREP_TRACEBACK only
     "pydantic",
     "numpy",
     "pyproj",
@@ -72,6 +74,9 @@ NOT_FOR_HELP = (
 #: any plugin but GOCAD's (geobrep's own are declared and imported on first use), meshio, the
 #: models of entity types the file does not hold.
 NOT_FOR_INFO = (
+    "difflib",
+    "traceback",
+    "email.parser",  # a METADATA file parsed whole
     "scipy",
     "pyproj",
     "meshio",
