@@ -16,7 +16,6 @@
 from __future__ import annotations
 
 import argparse
-import difflib
 import os
 import re
 import sys
@@ -128,7 +127,7 @@ class CliParser(argparse.ArgumentParser):
             if _NUMBER_LIKE.fullmatch(arg) or self._is_known(arg):
                 continue
             name = arg.split("=", 1)[0]
-            close = difflib.get_close_matches(name, self._option_strings(), n=1, cutoff=0.6)
+            close = _close_matches(name, self._option_strings(), n=1, cutoff=0.6)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
             self.error(f"unknown option {name!r}{hint}")
 
@@ -139,7 +138,7 @@ def _with_choice_hint(message: str) -> str:
     if not found:
         return message
     choices = re.findall(r"'([^']*)'", found.group(2))
-    close = difflib.get_close_matches(found.group(1), choices, n=1, cutoff=0.6)
+    close = _close_matches(found.group(1), choices, n=1, cutoff=0.6)
     return f"{message}; did you mean {close[0]!r}?" if close else message
 
 
@@ -192,7 +191,7 @@ def format_name(action: Literal["read", "write"]) -> Callable[[str], str]:
             return value
         if text in formats:
             raise argparse.ArgumentTypeError(f"format {text!r} cannot {action} files")
-        close = difflib.get_close_matches(text, [*names, *extensions], n=1, cutoff=0.6)
+        close = _close_matches(text, [*names, *extensions], n=1, cutoff=0.6)
         hint = f"; did you mean {close[0]!r}?" if close else ""
         raise argparse.ArgumentTypeError(
             f"unknown format {text!r} (known: {', '.join(names)}{hint})"
@@ -440,3 +439,10 @@ def progress_mode(progress: bool, no_progress: bool) -> Literal["auto", "always"
     if no_progress:
         return "never"
     return "always" if progress else "auto"
+
+
+def _close_matches(word: str, possibilities: Iterable[str], n: int, cutoff: float) -> list[str]:
+    """:func:`difflib.get_close_matches`, its module imported only for a mistyped word."""
+    import difflib
+
+    return difflib.get_close_matches(word, possibilities, n=n, cutoff=cutoff)

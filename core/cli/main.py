@@ -13,7 +13,6 @@ import gc
 import importlib
 import os
 import sys
-import traceback
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -287,6 +286,8 @@ def _run(argv: Sequence[str] | None, lines: WarningLines) -> int:
     except Exception as exc:
         lines.flush()
         if os.environ.get("GEOBREP_TRACEBACK"):
+            import traceback
+
             traceback.print_exc()
         print(
             f"geobrep: internal error: {type(exc).__name__}: {exc} "

@@ -80,9 +80,8 @@ def only_own_plugins() -> bool:
     plugins when this holds: geobrep's own plugins add no command.
     """
     import sys
-    from importlib.metadata import entry_points
 
-    from geobrep.host._entry_points import ENTRY_POINT_GROUP, is_own
+    from geobrep.host._entry_points import ENTRY_POINT_GROUP, entry_points, is_own
 
     loader = sys.modules.get("geobrep.host.loader")
     host = getattr(loader, "_host", None) if loader is not None else None

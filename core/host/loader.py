@@ -38,14 +38,14 @@ import types
 import warnings
 from collections.abc import Iterable
 from functools import cached_property, partial
-from importlib.metadata import EntryPoint, entry_points
 from typing import TYPE_CHECKING, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from geobrep.errors import PluginError
 from geobrep.host._declared import BUILTIN_PLUGINS
-from geobrep.host._entry_points import ENTRY_POINT_GROUP, PROJECT_NAME
+from geobrep.host._entry_points import ENTRY_POINT_GROUP, PROJECT_NAME, entry_points
+from geobrep.host._entry_points import EntryPointLike as EntryPoint
 from geobrep.host._entry_points import distribution as _distribution
 from geobrep.host._entry_points import is_builtin as _is_builtin
 from geobrep.host._entry_points import is_own as _is_own
