@@ -142,13 +142,14 @@ def test_info_of_a_tsurf_loads_only_what_it_needs() -> None:
     modules = found["modules"]
     assert not loaded(modules, NOT_FOR_INFO)
     assert "geobrep.adapters.gocad._reader" in modules  # it did read through GOCAD
-    # The models' validators are built on first use: of the entity models only the Surface the
-    # file holds (the scene's union of entity types does not build each type's own), and none
+    # The models' validators are built on first use: none of the entity models (the reader
+    # makes the Surface's fields in their validated form and runs its cross-field checks
+    # itself; the scene's union of entity types does not build each type's own), and none
     # of the models of formats and operations the command does not use.
     built = found["built"]
     assert isinstance(built, list)
     entities = {name.rsplit(".", 1)[1] for name in built if ".model.entities." in name}
-    assert entities == {"Surface"}
+    assert entities == set()
     assert not [name for name in built if name.startswith(NOT_BUILT_FOR_INFO)]
 
 
