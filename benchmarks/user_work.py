@@ -187,6 +187,13 @@ def startup(repeat: int, folder: Path) -> None:
         meshio_info,
         "(what any geobrep read pays first)",
     )
+    row(
+        "python + numpy + pydantic's BaseModel, imported",
+        whole_process([*python, "import numpy; from pydantic import BaseModel"], repeat),
+        "meshio info (same .vtu)",
+        meshio_info,
+        "(the imports alone, no model)",
+    )
     ts = DATA / "2triangles.ts"
     row(
         "geobrep info (2-triangle .ts)",
