@@ -31,6 +31,34 @@ def described(entry_points: Any) -> list[tuple[Any, ...]]:
     ]
 
 
+@pytest.fixture(autouse=True)
+def only_the_path_finder(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The import system as a fresh interpreter has it: the path finder the only one that finds
+    distributions. A package imported earlier in the test run may change that: the
+    ``importlib_metadata`` backport adds its own finder and deletes the path finder's
+    ``find_distributions``. The scan then leaves the answer to importlib.metadata (tested
+    below), which the other tests would not see."""
+    from importlib.machinery import PathFinder
+
+    if not hasattr(PathFinder, "find_distributions"):
+
+        def find_distributions(*args: Any, **kwargs: Any) -> Any:
+            return metadata.MetadataPathFinder.find_distributions(*args, **kwargs)
+
+        monkeypatch.setattr(
+            PathFinder, "find_distributions", staticmethod(find_distributions), raising=False
+        )
+    monkeypatch.setattr(
+        sys,
+        "meta_path",
+        [
+            finder
+            for finder in sys.meta_path
+            if finder is PathFinder or getattr(finder, "find_distributions", None) is None
+        ],
+    )
+
+
 def groups() -> list[str]:
     return sorted(metadata.entry_points().groups)
 
@@ -254,6 +282,22 @@ def test_another_distribution_finder_is_left_to_importlib_metadata(
     with pytest.raises(scan._UnsettledError):
         scan._scan(ENTRY_POINT_GROUP)
     same_as_importlib(ENTRY_POINT_GROUP, fast=False)
+
+
+def test_the_importlib_metadata_backport_s_finder_is_left_to_importlib_metadata(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The backport puts its finder on ``sys.meta_path`` when imported (a test run imports it
+    through other packages): the scan defers, and the loader still finds the built-ins."""
+    backport = pytest.importorskip("importlib_metadata")
+    finder = backport.MetadataPathFinder
+    monkeypatch.setattr(sys, "meta_path", [*sys.meta_path, finder])
+    with pytest.raises(scan._UnsettledError):
+        scan._scan(ENTRY_POINT_GROUP)
+    same_as_importlib(ENTRY_POINT_GROUP, fast=False)
+    eps = discover_entry_points()
+    assert {ep.name for ep in eps} >= {"native", "gocad", "clip", "blocks"}
+    assert all(scan.distribution(ep)[0] == "geobrep" for ep in eps if scan.is_builtin(ep))
 
 
 def test_entry_point_load_and_module_as_importlib_metadata() -> None:
