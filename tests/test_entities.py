@@ -1075,3 +1075,60 @@ def test_structural_equality_of_plain_leaves_and_their_subclasses() -> None:
     assert structurally_equal(math.nan, math.nan)
     assert not structurally_equal(np.zeros(2), "x")
     assert not structurally_equal("x", np.zeros(2))
+
+
+def _constructed_surface(faces: list[list[int]], **extra: Any) -> Surface:
+    """A Surface made as a reader makes one whose fields are in their validated form."""
+    from geobrep.model.arrays import as_readonly
+
+    count = len(faces)
+    fields: dict[str, Any] = {
+        "vertices": as_readonly(np.array(SQUARE)),
+        "faces": as_readonly(np.array(faces, dtype=np.int64)),
+        "patch_labels": as_readonly(np.zeros(count, dtype=np.int64)),
+        "patch_names": ("0",),
+        "name": "made",
+    }
+    return Surface.model_construct(**{**fields, **extra})
+
+
+@pytest.mark.parametrize(
+    ("faces", "extra", "field"),
+    [
+        ([[0, 1, 4]], {}, "faces"),
+        ([[0, 1, 2]], {"patch_labels": np.array([1], dtype=np.int64)}, "patch_labels"),
+        (
+            [[0, 1, 2], [0, 2, 3]],
+            {"cell_data": {"rock": Property(values=np.zeros(3))}},
+            "cell_data['rock']",
+        ),
+    ],
+)
+def test_check_fields_of_a_constructed_entity_raises_what_validation_raises(
+    faces: list[list[int]], extra: dict[str, Any], field: str
+) -> None:
+    """``check_fields`` (what a reader calls on an entity it built by ``model_construct``)
+    raises the error that building the same entity by validation raises."""
+    from geobrep.model.properties import PropertyMap
+
+    if "cell_data" in extra:
+        extra = {"cell_data": PropertyMap(extra["cell_data"])}
+    with pytest.raises(EntityValidationError) as validated:
+        Surface(**{**_constructed_surface(faces, **extra).__dict__})
+    error = invalid(
+        lambda: _constructed_surface(faces, **extra).check_fields(), "Surface 'made'", field
+    )
+    assert str(error) == str(validated.value)
+
+
+def test_check_fields_passes_and_marks_a_sound_constructed_entity() -> None:
+    surface = _constructed_surface([[0, 1, 2], [0, 2, 3]])
+    surface.check_fields()
+    assert surface._checked
+    assert surface == Surface(
+        vertices=SQUARE,
+        faces=[[0, 1, 2], [0, 2, 3]],
+        name="made",
+        patch_labels=[0, 0],
+        patch_names=("0",),
+    )

@@ -105,3 +105,26 @@ def test_component_major_gathers_the_corners() -> None:
     stored = component_major(np.ascontiguousarray(vertices.T), triangles)
     assert stored.shape == (3, 3, 2000)
     assert np.array_equal(stored, np.transpose(vertices[triangles], (1, 2, 0)))
+
+
+@pytest.mark.parametrize(
+    "shape", [(1, 1, 1), (1, 1, 2), (2, 3, 1), (3, 1, 5), (2, 2, 2), (4, 5, 3), (7, 6, 9)]
+)
+@pytest.mark.parametrize("op", ["minimum", "maximum"])
+def test_grid_dilation_is_the_3x3x3_filter(shape: tuple[int, int, int], op: str) -> None:
+    """The broad phase's dilation (the last axis in one pass over the flattened cells, the row
+    ends fixed) is scipy's 3 x 3 x 3 minimum / maximum filter: a cell at the grid's edge takes
+    the cells there are ("nearest" repeats one of them)."""
+    from scipy import ndimage
+
+    from geobrep.plugins.blocks._broad_phase import _dilated
+
+    rng = np.random.default_rng(sum(shape))
+    values = rng.integers(-1000, 1000, size=shape).astype(np.int64)
+    function = np.minimum if op == "minimum" else np.maximum
+    reference = (ndimage.minimum_filter if op == "minimum" else ndimage.maximum_filter)(
+        values, size=3, mode="nearest"
+    )
+    dilated = _dilated(values, function)
+    np.testing.assert_array_equal(dilated, reference)
+    np.testing.assert_array_equal(_dilated(values.astype(np.float64), function), reference)
