@@ -209,13 +209,17 @@ def scan(source: Source, start: int = 0) -> Iterator[Line | Run]:
     if first >= len(pairs):
         return
     runs = iter(source.runs[bisect.bisect_left(source.runs, pairs[first][0] + 1, key=_first) :])
+    data, n_bulk = source.data, len(BULK_KEYWORDS)
     for lo, hi in pairs[first:]:
-        if 0 < codes[lo] <= len(BULK_KEYWORDS):
+        if 0 < codes[lo] <= n_bulk:
             yield next(runs)
             continue
-        for index in range(max(lo, start), hi):
-            text = source.text(index).strip()
-            if not text or (text.startswith("#") and not text.startswith("# CTETRA")):
+        lo = max(lo, start)
+        # the stretch's line bounds as Python ints (a numpy scalar per line costs more)
+        bounds = zip(source.starts[lo:hi].tolist(), source.ends[lo:hi].tolist(), strict=True)
+        for index, (begin, end) in enumerate(bounds, start=lo):
+            text = decode(data[begin:end]).strip()
+            if not text or (text[0] == "#" and not text.startswith("# CTETRA")):
                 continue
             yield Line(index + 1, text)
 

@@ -417,9 +417,11 @@ class _Parser:
                 crs[keyword] = value
         obj.crs = crs
 
-    def _common(self, obj: GocadObject, item: Line) -> bool:
-        """Handle a header-part line; False when it is not one."""
-        keyword = _keyword(item.text)
+    def _common(self, obj: GocadObject, item: Line, keyword: str | None = None) -> bool:
+        """Handle a header-part line (its :func:`_keyword` ``keyword`` when known); False when
+        it is not one."""
+        if keyword is None:
+            keyword = _keyword(item.text)
         if keyword == "HEADER" or keyword.startswith("HEADER{"):
             self._header_block(obj, item)
         elif keyword == "GOCAD_ORIGINAL_COORDINATE_SYSTEM":
@@ -466,7 +468,8 @@ class _Parser:
             if item is None:
                 self.warn(f"{obj.type} {obj.name!r} has no END", obj.line)
                 break
-            if isinstance(item, Line) and _keyword(item.text) == "GOCAD":
+            keyword = "" if isinstance(item, Run) else _keyword(item.text)
+            if keyword == "GOCAD":
                 self.warn(f"{obj.type} {obj.name!r} has no END", obj.line)
                 break
             self.stream.take()
@@ -477,16 +480,15 @@ class _Parser:
                         break
                 part = self._run(obj, item, vertices, cells, part, solid)
                 continue
-            keyword = _keyword(item.text)
             if keyword == "END":
                 break
             if header is not None:  # a Model3d
-                if not self._common(obj, item):
+                if not self._common(obj, item, keyword):
                     self._model3d_entry(obj, item, keyword, header)
                 continue
             if vertices is None:
                 # Header part: the property header is only complete at the first data line.
-                if self._common(obj, item):
+                if self._common(obj, item, keyword):
                     continue
                 if keyword in _SKIP_BLOCKS:
                     self._skip_block(keyword, item.number)
@@ -501,7 +503,7 @@ class _Parser:
                 vertices, cells = self._tables(obj)
                 if self._bulk_body(obj, item.number, vertices, cells):
                     break
-            elif self._common(obj, item):
+            elif self._common(obj, item, keyword):
                 self.warn(f"{keyword} after the object's data lines", item.number)
                 continue
             part = self._element_line(obj, item, keyword, vertices, cells, part, solid)
@@ -1001,14 +1003,13 @@ class _Parser:
     ) -> None:
         """:meth:`_model3d_line`, with a bad number named with its keyword and line."""
         try:
-            self._model3d_line(obj, item, header)
+            self._model3d_line(obj, item, keyword, header)
         except ValueError as exc:
             if isinstance(exc, FormatError):
                 raise
             raise self.error(f"{keyword}: {exc}", item.number) from None
 
-    def _model3d_line(self, obj: GocadObject, item: Line, header: ModelDraft) -> None:
-        keyword = _keyword(item.text)
+    def _model3d_line(self, obj: GocadObject, item: Line, keyword: str, header: ModelDraft) -> None:
         text = item.text
         if keyword == "TSURF":
             name = _unquote(text[len(keyword) :].strip())
@@ -1121,7 +1122,7 @@ class _Parser:
                 return
             elif keyword == "TYPE":
                 obj.member_type = item.text[len(keyword) :].strip()
-            elif not self._common(obj, item):
+            elif not self._common(obj, item, keyword):
                 self.warn(f"unknown keyword {keyword!r} in a group; line kept", item.number)
                 obj.extra_lines.append(item.text)
 
