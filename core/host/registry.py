@@ -358,7 +358,7 @@ class FormatSpec(RegisteredItem):
     reader: Reader | None = None
     writer: Writer | None = None
     sniff: Sniffer | None = None
-    capabilities: FormatCapabilities = FormatCapabilities()
+    capabilities: FormatCapabilities = FormatCapabilities.model_construct()
     losses: LossReporter | None = None
     """``losses(scene, path) -> [sentence, ...]``: what the writer drops for this target beyond
     what :attr:`capabilities` says (e.g. a GOCAD .ts holds surfaces only)."""
