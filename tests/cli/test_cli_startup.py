@@ -284,3 +284,25 @@ def test_info_scans_the_installed_entry_points_once() -> None:
     assert status == 0
     assert "2 faces" in out
     assert groups.count("geobrep.plugins") == 1
+
+
+def test_the_format_registry_builds_no_schema_when_imported() -> None:
+    """Importing the registry builds no model's validator, so pydantic's plugin loader (and
+    importlib.metadata with it) waits for the first model a command really uses."""
+    code = (
+        "import json, sys; import geobrep.host.registry as r; "
+        "spec = r.FormatSpec.__pydantic_complete__, r.FormatCapabilities.__pydantic_complete__; "
+        "print(json.dumps({'complete': spec, 'modules': sorted(sys.modules)}))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    found = json.loads(done.stdout.splitlines()[-1])
+    assert found["complete"] == [False, False]
+    assert not loaded(found["modules"], ("pydantic.plugin._loader", "importlib.metadata"))
+    # The default capabilities made without validation equal validated ones.
+    from geobrep.host.registry import FormatCapabilities, FormatSpec
+
+    default = FormatSpec(name="probe-format", reader=lambda path, options: Scene()).capabilities
+    assert default == FormatCapabilities()
+    assert hash(default) == hash(FormatCapabilities())
+    assert repr(default) == repr(FormatCapabilities())
