@@ -358,6 +358,8 @@ class FormatSpec(RegisteredItem):
     reader: Reader | None = None
     writer: Writer | None = None
     sniff: Sniffer | None = None
+    # made without validation (it equals FormatCapabilities()): a validated default would build
+    # the schema, and pydantic's plugin loader with it, when this module is imported
     capabilities: FormatCapabilities = FormatCapabilities.model_construct()
     losses: LossReporter | None = None
     """``losses(scene, path) -> [sentence, ...]``: what the writer drops for this target beyond
