@@ -461,10 +461,16 @@ def component_major(columns: FloatArray, triangles: IntArray) -> FloatArray:
 
 
 def stored_pairs(
-    stored: FloatArray, groups: IntArray, margin: float = 0.0, cell: float | None = None
+    stored: FloatArray,
+    groups: IntArray,
+    margin: float = 0.0,
+    cell: float | None = None,
+    triangles: IntArray | None = None,
 ) -> tuple[IntArray, IntArray]:
     """:func:`overlapping_pairs` of triangles given component-major, ``stored`` (corner, xyz,
-    K) float64, as callers that gather the corners that way pass them (no transposed copy)."""
+    K) float64, as callers that gather the corners that way pass them (no transposed copy).
+    ``triangles``: the vertices (K, 3) of the triangles; pairs sharing one are then left out
+    (the others in the same order)."""
     n = stored.shape[2]
     empty = np.zeros(0, dtype=np.int64)
     if n == 0:
@@ -526,7 +532,7 @@ def stored_pairs(
         box, key, code = box[keep], key[keep], code[keep]
     if box.size == 0:
         return empty, empty
-    return _cell_pairs(box, key, code, shifted, mins, maxs, large)
+    return _cell_pairs(box, key, code, shifted, (mins, maxs), large, triangles)
 
 
 def _cell_pairs(
@@ -534,11 +540,13 @@ def _cell_pairs(
     key: IntArray,
     code: IntArray,
     groups: IntArray,
-    mins: FloatArray,
-    maxs: FloatArray,
+    bounds: tuple[FloatArray, FloatArray],
     large: BoolArray,
+    triangles: IntArray | None = None,
 ) -> tuple[IntArray, IntArray]:
-    """Pairs of boxes of different groups sharing a cell, from rows (box, cell key, code)."""
+    """Pairs of boxes of different groups sharing a cell, from rows (box, cell key, code);
+    with ``triangles`` (vertices of each box's triangle), none of two sharing a vertex."""
+    mins, maxs = bounds
     n = groups.shape[0]
     group = np.take(groups, box)
     box_bits = max((n - 1).bit_length(), 1)
@@ -579,8 +587,18 @@ def _cell_pairs(
         low, high = np.take(mins[k], box), np.take(maxs[k], box)
         keep &= np.take(low, first_row) <= np.take(high, second_row)
         keep &= np.take(low, second_row) <= np.take(high, first_row)
-    first = np.take(box, np.compress(keep, first_row))
-    second = np.take(box, np.compress(keep, second_row))
+    first_row, second_row = np.compress(keep, first_row), np.compress(keep, second_row)
+    if triangles is not None:
+        # Vertices gathered per row first too; a stable mask, so the pairs left keep their order.
+        corner = [np.take(triangles[:, k], box) for k in range(3)]
+        theirs = [np.take(c, second_row) for c in corner]
+        apart = np.ones(first_row.shape[0], dtype=np.bool_)
+        for c in corner:
+            mine = np.take(c, first_row)
+            for other in theirs:
+                apart &= mine != other
+        first_row, second_row = np.compress(apart, first_row), np.compress(apart, second_row)
+    first, second = np.take(box, first_row), np.take(box, second_row)
     once = ~(large[first] | large[second])
     if once.all():
         return first.astype(np.int64, copy=False), second.astype(np.int64, copy=False)

@@ -488,24 +488,30 @@ def _crossings(
     candidate pairs when the caller's broad phase (a wider margin) already found them (only
     their triangles are gathered then)."""
     local = soup.local_vertices
-    i, j = stored_pairs(soup.corners, soup.triangle_surface, margin=tol) if pairs is None else pairs
+    if pairs is None:
+        # The broad phase leaves out the pairs sharing a vertex (most candidates: neighbours
+        # across a shared line), keeping the order of the others.
+        i, j = stored_pairs(
+            soup.corners, soup.triangle_surface, margin=tol, triangles=soup.triangles
+        )
+    else:
+        i, j = pairs
+        # np.take: row gathers several times faster than fancy indexing on numpy 2.
+        ti, tj = np.take(soup.triangles, i, axis=0), np.take(soup.triangles, j, axis=0)
+        # Triangles sharing a vertex first, then boxes beyond the contact tolerance: both
+        # masks keep the order, so the pairs left are the same either way round.
+        apart = np.ones(i.shape[0], dtype=np.bool_)
+        for a in range(3):
+            for b in range(3):
+                apart &= ti[:, a] != tj[:, b]
+        i, j, ti, tj = i[apart], j[apart], ti[apart], tj[apart]
+        near = _boxes_within(local, ti, tj, tol)
+        i, j = i[near], j[near]
     if i.size == 0:
         return []
-    # np.take: row gathers several times faster than fancy indexing on numpy 2.
-    ti, tj = np.take(soup.triangles, i, axis=0), np.take(soup.triangles, j, axis=0)
-    # Triangles sharing a vertex (most candidates: neighbours across a shared line) first,
-    # then, for a caller's wider broad phase, boxes beyond the contact tolerance: both masks
-    # keep the order, so the pairs left are the same either way round.
-    apart = np.ones(i.shape[0], dtype=np.bool_)
-    for a in range(3):
-        for b in range(3):
-            apart &= ti[:, a] != tj[:, b]
-    i, j, ti, tj = i[apart], j[apart], ti[apart], tj[apart]
-    if pairs is not None:
-        near = _boxes_within(local, ti, tj, tol)
-        i, j, ti, tj = i[near], j[near], ti[near], tj[near]
     hit = _pairs_intersect(soup.corners, i, j, tol)
-    i, j, ti, tj = i[hit], j[hit], ti[hit], tj[hit]
+    i, j = i[hit], j[hit]
+    ti, tj = np.take(soup.triangles, i, axis=0), np.take(soup.triangles, j, axis=0)
     if i.size == 0:
         return []
     first, second = np.take(local, ti, axis=0), np.take(local, tj, axis=0)

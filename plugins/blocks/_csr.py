@@ -19,8 +19,9 @@ def concatenated_ranges(starts: IntArray, counts: IntArray) -> IntArray:
     [5, 6, 0, 1, 2]
     """
     total = int(counts.sum())
-    shift = np.repeat(starts - (np.cumsum(counts) - counts), counts)
-    ranges: IntArray = np.arange(total, dtype=np.int64) + shift.astype(np.int64)
+    shift = (starts - (np.cumsum(counts) - counts)).astype(np.int64, copy=False)
+    ranges: IntArray = np.arange(total, dtype=np.int64)
+    ranges += np.repeat(shift, counts)  # in place: no third array as long as the ranges
     return ranges
 
 

@@ -75,8 +75,10 @@ def split_patches(soup: Soup) -> PatchSplit:
     is_arc = counts != 2
     is_arc[pair[~manifold]] = True
 
+    # float64 weights: the dtype connected_components works in (int8 ones were converted to a
+    # float64 copy of the matrix there).
     graph = coo_matrix(
-        (np.ones(int(manifold.sum()), dtype=np.int8), (t1[manifold], t2[manifold])),
+        (np.ones(int(manifold.sum()), dtype=np.float64), (t1[manifold], t2[manifold])),
         shape=(n_triangles, n_triangles),
     )
     n_components, labels = connected_components(graph, directed=False)
