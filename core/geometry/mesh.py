@@ -22,7 +22,7 @@ from geobrep.geometry.graph import (
     hashed_order,
 )
 from geobrep.geometry.plane import _as_float_array, _as_point, _check_tolerance
-from geobrep.geometry.sorting import RADIX_MIN, digit_order, radix_order, radix_pays, sorted_keys
+from geobrep.geometry.sorting import digit_order, radix_order, radix_pays, sorted_keys
 
 __all__ = [
     "boundary_edges",
@@ -403,10 +403,10 @@ def edge_face_incidence(faces: ArrayLike) -> tuple[IntArray, IntArray, IntArray,
     m, k = f.shape
     vertex_bits = max(int(f.max(initial=0)).bit_length(), 1)
     side_bits = max((m * k - 1).bit_length(), 1)
-    if m and radix_pays(m * k, 2 * vertex_bits) and not _in_runs(f):
-        return _incidence_by_radix(f, vertex_bits)
     if m and 2 * vertex_bits + side_bits <= 63:
         return _incidence_by_bits(f, vertex_bits, side_bits)
+    if m and radix_pays(m * k, 2 * vertex_bits):
+        return _incidence_by_radix(f, vertex_bits)
     edges, offsets, perm, _ = _edge_groups(f)
     face = perm // k
     return edges, offsets, face, perm - face * k
@@ -482,7 +482,8 @@ def _incidence_by_bits(
         packed[rows] = low
     flat = packed.reshape(-1)
     flat |= np.arange(m * k, dtype=np.int64)
-    flat.sort(kind="stable")
+    # the keys are unique (positions packed in): every sort kind gives the same order
+    flat.sort(kind="stable" if _in_runs(faces) else "quicksort")
     mask = (1 << side_bits) - 1
     position = flat & mask
     flat >>= side_bits  # the edge keys, ascending
@@ -532,14 +533,17 @@ def is_consistently_oriented(faces: ArrayLike) -> bool:
     False
     """
     f = _as_faces(faces, "is_consistently_oriented")
-    if f.size >= RADIX_MIN and int(f.max()) < 1 << 16:  # indices are >= 0
-        # sides ordered by (start, end) in two radix passes of their 16-bit vertices
-        start = f.astype(np.uint16).reshape(-1)
-        end = _following(f).astype(np.uint16).reshape(-1)
-        order = digit_order(start, end)
-        start, end = np.take(start, order), np.take(end, order)
-        return bool(((start[1:] != start[:-1]) | (end[1:] != end[:-1])).all())
-    s = sorted_keys(_directed_keys(f))
+    if f.size == 0:
+        return True
+    bits = max(int(f.max()).bit_length(), 1)
+    if 2 * bits <= 63:  # the indices are >= 0
+        # one int64 key (start, end) per side as bit fields, sorted by numpy's own sort
+        # (faster than radix passes of 16-bit digits or a stable sort of keys in no order)
+        keys = f << bits
+        keys |= _following(f)
+        s = np.sort(keys.reshape(-1))
+    else:
+        s = sorted_keys(_directed_keys(f))
     return bool((s[1:] != s[:-1]).all())
 
 

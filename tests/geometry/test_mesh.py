@@ -506,3 +506,36 @@ def test_signed_volume_in_chunks_is_trimeshs(chunk: int, monkeypatch: pytest.Mon
     faces = np.asarray(sphere.faces)
     assert signed_volume(vertices, faces) == pytest.approx(sphere.volume, rel=1e-12)
     assert signed_volume(vertices, faces[:, ::-1]) == pytest.approx(-sphere.volume, rel=1e-12)
+
+
+def test_incidence_and_orientation_of_large_shuffled_meshes() -> None:
+    """Faces in no order (the packed quicksort path) give the incidence of a plain lexsort;
+    one repeated directed edge among many makes the mesh inconsistently oriented."""
+    from geobrep.geometry.mesh import edge_face_incidence, is_consistently_oriented
+
+    rng = np.random.default_rng(5)
+    faces = rng.permutation(4000)[:, None] + np.array([0, 1, 2])
+    faces = rng.permutation(faces)  # no runs of ascending first vertices
+    edges, offsets, fs, sides = edge_face_incidence(faces)
+    start = faces.reshape(-1)
+    end = faces[:, [1, 2, 0]].reshape(-1)
+    low, high = np.minimum(start, end), np.maximum(start, end)
+    order = np.lexsort((np.arange(low.shape[0]), high, low))
+    assert np.array_equal(fs, order // 3)
+    assert np.array_equal(sides, order % 3)
+    starts = np.flatnonzero(np.r_[True, np.diff(low[order] * 10**6 + high[order]) != 0])
+    assert np.array_equal(offsets, np.r_[starts, order.shape[0]])
+    assert np.array_equal(edges, np.column_stack([low[order][starts], high[order][starts]]))
+    grid = np.arange(100 * 100).reshape(100, 100)
+    a, b, c, d = (
+        grid[:-1, :-1].ravel(),
+        grid[:-1, 1:].ravel(),
+        grid[1:, :-1].ravel(),
+        grid[1:, 1:].ravel(),
+    )
+    mesh_faces = rng.permutation(
+        np.concatenate([np.column_stack([a, b, c]), np.column_stack([b, d, c])])
+    )
+    assert is_consistently_oriented(mesh_faces)
+    mesh_faces[0] = mesh_faces[0, ::-1]
+    assert not is_consistently_oriented(mesh_faces)
